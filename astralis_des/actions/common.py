@@ -1,0 +1,118 @@
+"""What every action uses: travelling a route, sensing along it, searching a room."""
+
+from __future__ import annotations
+
+from collections.abc import Generator
+from typing import Any, Protocol
+
+import numpy as np
+import simpy
+
+from astralis_des.kernel.robot import Motion, Robot
+from astralis_des.kernel.tasks import ActionResult, Task, TaskStatus
+from astralis_des.kinds import TARGET_HEIGHT
+from astralis_des.sensing import GeometricSensor, Sighting
+from astralis_des.world.geometry import FloatArray
+from astralis_des.world.model import Room, World
+
+ActionGen = Generator[simpy.Event, Any, ActionResult]
+StepGen = Generator[simpy.Event, Any, float]
+
+
+class CoSim(Protocol):
+    def execute(self, robot: Robot, motion: Motion) -> simpy.Event: ...
+    def dwell(self, robot: Robot, seconds: float) -> simpy.Event: ...
+    def halt(self, robot: Robot) -> None: ...
+
+
+class Context(Protocol):
+    """What a :class:`~astralis_des.kernel.simulation.Simulation` offers to actions."""
+
+    env: simpy.Environment
+    world: World
+    cosim: CoSim
+    sensor: GeometricSensor
+
+    def report_detection(self, robot: Robot, sighting: Sighting) -> None: ...
+
+
+def result(status: TaskStatus, message: str, **kw: Any) -> ActionResult:
+    return ActionResult(status, message, **kw)
+
+
+def failed(message: str) -> ActionResult:
+    return ActionResult(TaskStatus.FAILED, message)
+
+
+def room_of(ctx: Context, task: Task) -> Room | None:
+    return ctx.world.rooms.get(task.room) if task.room else None
+
+
+def at_height(robot: Robot, floor_points: FloatArray) -> FloatArray:
+    pts = np.array(floor_points, dtype=float)
+    pts[:, 2] += robot.height
+    return pts
+
+
+def route(ctx: Context, robot: Robot, goal_floor: FloatArray | tuple[float, ...]) -> FloatArray | None:
+    """Route from where the robot is to a floor-level goal, at the robot's sensor height."""
+    here = robot.position(ctx.env.now) - np.array([0.0, 0.0, robot.height])
+    pts = ctx.world.router.route(here, goal_floor, robot.kind)
+    return None if pts is None else at_height(robot, pts)
+
+
+def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> StepGen:
+    """Follow ``points``; when sensing, report the target the moment it comes into view."""
+    before = robot.distance
+    motion = Motion(points, robot.speed)
+    done = ctx.cosim.execute(robot, motion)
+    if sense:
+        hit = ctx.sensor.first_sighting(robot, motion)
+        if hit is not None:
+            yield ctx.env.timeout(hit.t)
+            ctx.report_detection(robot, hit)
+    yield done
+    ctx.cosim.halt(robot)
+    return robot.distance - before
+
+
+def dwell(ctx: Context, robot: Robot, seconds: float) -> StepGen:
+    """Stay and look around from where the robot is."""
+    ctx.cosim.halt(robot)
+    hit = ctx.sensor.sighting_from(robot, robot.position(ctx.env.now))
+    if hit is not None:
+        ctx.report_detection(robot, hit)
+    yield ctx.cosim.dwell(robot, seconds)
+    return 0.0
+
+
+def go_to(ctx: Context, robot: Robot, goal_floor: tuple[float, ...]) -> ActionGen:
+    points = route(ctx, robot, goal_floor)
+    if points is None:
+        return failed(f"no route for a {robot.kind} to {tuple(round(v, 2) for v in goal_floor)}")
+    distance = yield from traverse(ctx, robot, points, sense=False)
+    return result(TaskStatus.SUCCEEDED, "arrived", distance=distance)
+
+
+def search_path(ctx: Context, robot: Robot, room: Room, plan: FloatArray, label: str) -> ActionGen:
+    """Go to the start of a coverage path ``plan`` (floor level) and follow it, sensing."""
+    approach = route(ctx, robot, plan[0])
+    if approach is None:
+        return failed(f"no route for a {robot.kind} to room {room.id}")
+    distance = yield from traverse(ctx, robot, approach, sense=False)
+    sweep = at_height(robot, plan)
+    coverage = ctx.sensor.coverage(robot, sweep, room)
+    distance += yield from traverse(ctx, robot, sweep, sense=True)
+    return result(TaskStatus.SUCCEEDED, f"{label} saw {coverage:.0%} of {room.id}",
+                  distance=distance, coverage=coverage)
+
+
+def footprint_spacing(robot: Robot, overlap: float) -> float:
+    """Distance between passes: the width the sensor sees on the floor, less the overlap."""
+    drop = max(robot.height - TARGET_HEIGHT, 0.0)
+    reach = np.sqrt(max(robot.detection_radius**2 - drop**2, 0.01))
+    return float(max(2.0 * reach * (1.0 - overlap), 0.5))
+
+
+def plane_to_floor(room: Room, plane: FloatArray) -> FloatArray:
+    return np.column_stack([plane, np.full(len(plane), room.box.lo[2])])

@@ -1,0 +1,26 @@
+"""``move``: every kind goes to a place (a room's centre or door, or a point)."""
+
+from __future__ import annotations
+
+from astralis_des.actions import ACTIONS
+from astralis_des.actions.common import ActionGen, Context, failed, go_to, room_of
+from astralis_des.kernel.robot import Robot
+from astralis_des.kernel.tasks import Task
+from astralis_des.kinds import KINDS
+
+
+def move(ctx: Context, robot: Robot, task: Task) -> ActionGen:
+    """Params: ``point`` = ``center`` (default) or ``door`` with a room; or ``x``, ``y``, ``z``."""
+    room = room_of(ctx, task)
+    if room is not None:
+        where = task.param("point", "center")
+        goal = room.center if where == "center" else room.door_point("corridor")
+    elif all(k in dict(task.params) for k in ("x", "y")):
+        goal = (float(task.param("x", 0)), float(task.param("y", 0)), float(task.param("z", 0)))
+    else:
+        return failed("move needs a room or x and y")
+    return (yield from go_to(ctx, robot, goal))
+
+
+for _kind in KINDS:
+    ACTIONS.register((_kind, "move"))(move)

@@ -1,0 +1,70 @@
+"""Assignment strategies by registry: ``mixed`` (Eq. 1 with W1, W2) and ``naive`` (distance)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from astralis_des.assignment.eq1 import Agent, RoomInfo, Weights, eq1_costs
+from astralis_des.assignment.matching import match
+from astralis_des.assignment.rules import table4_action
+from astralis_des.registry import Registry
+
+
+@dataclass(frozen=True)
+class Pair:
+    agent: str
+    room: str
+    cost: float
+    action: str
+
+
+@dataclass(frozen=True)
+class Assignment:
+    agents: tuple[str, ...]
+    rooms: tuple[str, ...]
+    costs: NDArray[np.float64]
+    pairs: tuple[Pair, ...]
+    unassigned: tuple[str, ...]
+
+    @property
+    def total_cost(self) -> float:
+        return float(sum(p.cost for p in self.pairs))
+
+    def room_of(self, agent: str) -> str | None:
+        return next((p.room for p in self.pairs if p.agent == agent), None)
+
+
+Strategy = Callable[[Sequence[Agent], Sequence[RoomInfo], Weights], NDArray[np.float64]]
+STRATEGIES: Registry[str, Strategy] = Registry("assignment strategy")
+
+
+@STRATEGIES.register("mixed")
+def mixed(agents: Sequence[Agent], rooms: Sequence[RoomInfo], weights: Weights) -> NDArray[np.float64]:
+    """The paper's mixed heuristic: Eq. 1 with the risk and messiness weights."""
+    return eq1_costs(agents, rooms, weights)
+
+
+@STRATEGIES.register("naive")
+def naive(agents: Sequence[Agent], rooms: Sequence[RoomInfo], weights: Weights) -> NDArray[np.float64]:
+    """The paper's baseline: Eq. 1's normalised distance alone."""
+    return eq1_costs(agents, rooms, Weights.zero())
+
+
+def assign(agents: Sequence[Agent], rooms: Sequence[RoomInfo], weights: Weights, *,
+           strategy: str = "mixed", solver: str = "scipy", high_risk: float = 0.5,
+           high_messiness: float = 0.5) -> Assignment:
+    """Match agents to rooms and pick each matched agent's action by Table IV."""
+    costs = STRATEGIES.get(strategy)(agents, rooms, weights)
+    pairs = tuple(
+        Pair(agents[i].id, rooms[j].id, float(costs[i, j]),
+             table4_action(agents[i].kind, rooms[j].risk, rooms[j].messiness, high_risk,
+                           high_messiness))
+        for i, j in match(costs, solver)
+    )
+    matched = {p.agent for p in pairs}
+    return Assignment(tuple(a.id for a in agents), tuple(r.id for r in rooms), costs, pairs,
+                      tuple(a.id for a in agents if a.id not in matched))

@@ -1,0 +1,1 @@
+"""The event kernel: tasks, task handlers, robots, the event log and the simulation."""

@@ -1,0 +1,55 @@
+"""Typed event records: time, kind, robot and payload; handed to every sink as they happen."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import simpy
+
+Record = dict[str, Any]
+Sink = Callable[[Record], None]
+
+# How a replay shows each kind: detections and faults stand out.
+LEVELS: dict[str, str] = {
+    "detection": "CRITICAL", "fault": "ERROR", "task_failed": "WARN", "room_given_up": "WARN",
+    "mission_end": "INFO", "assignment": "INFO", "command": "INFO", "room_change": "INFO",
+}
+
+
+class EventLog:
+    """Append-only list of records; sinks see each one the moment it is emitted."""
+
+    def __init__(self, env: simpy.Environment) -> None:
+        self.env = env
+        self.records: list[Record] = []
+        self.sinks: list[Sink] = []
+
+    def emit(self, kind: str, robot: str | None = None, **payload: Any) -> Record:
+        record: Record = {"t": round(float(self.env.now), 6), "kind": kind}
+        if robot is not None:
+            record["robot"] = robot
+        record.update({k: plain(v) for k, v in payload.items()})
+        self.records.append(record)
+        for sink in self.sinks:
+            sink(record)
+        return record
+
+    def of_kind(self, kind: str) -> list[Record]:
+        return [r for r in self.records if r["kind"] == kind]
+
+
+def plain(value: Any) -> Any:
+    """JSON-ready, deterministic: numpy to Python, floats rounded to the micrometre/microsecond."""
+    if isinstance(value, np.ndarray):
+        return plain(value.tolist())
+    if isinstance(value, np.generic):
+        return plain(value.item())
+    if isinstance(value, float):
+        return round(value, 6)
+    if isinstance(value, dict):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [plain(v) for v in value]
+    return value

@@ -1,0 +1,92 @@
+"""A robot's task handler: a FIFO :class:`simpy.Store` of tasks and one worker process."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Generator
+from typing import Any
+
+import simpy
+
+from astralis_des.kernel.tasks import ActionResult, Stop, Task, TaskStatus
+
+ActionRunner = Callable[[Task], Generator[simpy.Event, Any, ActionResult]]
+
+
+class TaskHandler:
+    """Runs one robot's tasks in first-in, first-out order.
+
+    ``submit`` returns an event that succeeds with the task's :class:`ActionResult`, whether it
+    ran, failed, was cancelled while queued or preempted while running.
+    """
+
+    def __init__(self, env: simpy.Environment, run: ActionRunner,
+                 on_change: Callable[[Task, ActionResult | None], None] | None = None) -> None:
+        self.env = env
+        self.queue: simpy.Store = simpy.Store(env)
+        self.current: Task | None = None
+        self._run = run
+        self._active: simpy.Process | None = None
+        self._done: dict[int, simpy.Event] = {}
+        self._on_change = on_change
+        self.worker = env.process(self._work())
+
+    @property
+    def queued(self) -> list[Task]:
+        """Tasks waiting, in the order they will run."""
+        return list(self.queue.items)
+
+    def submit(self, task: Task, *, front: bool = False) -> simpy.Event:
+        done = self.env.event()
+        self._done[task.id] = done
+        self.queue.put(task)
+        if front:  # the put above is served on the next step, so reordering now is safe
+            self.queue.items.remove(task)
+            self.queue.items.insert(0, task)
+        return done
+
+    def done_event(self, task_id: int) -> simpy.Event:
+        return self._done[task_id]
+
+    def cancel(self, task_id: int | None = None, reason: str = "cancelled") -> list[Task]:
+        """Cancel one task (queued or running) or, with no id, all of them."""
+        hit = [t for t in self.queue.items if task_id in (None, t.id)]
+        for task in hit:
+            self.queue.items.remove(task)
+            self._settle(task, ActionResult(TaskStatus.CANCELLED, reason, self.env.now,
+                                            self.env.now))
+        if self.current is not None and task_id in (None, self.current.id):
+            hit.append(self.current)
+            self.stop_current(Stop(TaskStatus.CANCELLED, reason))
+        return hit
+
+    def preempt(self, task: Task, reason: str = "preempted") -> simpy.Event:
+        """Put ``task`` first and interrupt the running task, which ends ``preempted``."""
+        done = self.submit(task, front=True)
+        self.stop_current(Stop(TaskStatus.PREEMPTED, reason))
+        return done
+
+    def stop_current(self, cause: Stop) -> None:
+        if self._active is not None and self._active.is_alive:
+            self._active.interrupt(cause)
+
+    def _work(self) -> Generator[simpy.Event, Any, None]:
+        while True:
+            task = yield self.queue.get()
+            self.current = task
+            if self._on_change is not None:
+                self._on_change(task, None)
+            self._active = self.env.process(self._run(task))
+            try:
+                result = yield self._active
+            except simpy.Interrupt as stop:  # interrupted before its first step
+                cause = stop.cause
+                assert isinstance(cause, Stop)
+                result = ActionResult(cause.status, cause.message, self.env.now, self.env.now)
+            self._active = None
+            self.current = None
+            self._settle(task, result)
+
+    def _settle(self, task: Task, result: ActionResult) -> None:
+        if self._on_change is not None:
+            self._on_change(task, result)
+        self._done[task.id].succeed(result)

@@ -1,0 +1,81 @@
+"""What a run returns, and the ``summary.json`` it writes."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from astralis_des.kernel.events import Record, plain
+
+if TYPE_CHECKING:
+    from astralis_des.kernel.simulation import Simulation
+
+
+@dataclass(frozen=True)
+class RobotStats:
+    kind: str
+    distance: float
+    busy_time: float
+    idle_time: float
+    tasks_succeeded: int
+    tasks_failed: int
+    tasks_cancelled: int
+    faulted: bool
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """The outcome of one mission run, with everything a study needs to tabulate it."""
+
+    mission: str
+    seed: int
+    fidelity: str
+    outcome: str  # found | not_found | team_lost | time_limit | interrupted
+    end_time: float
+    time_to_find: float | None
+    found_by: str | None
+    target: dict[str, Any]
+    robots: dict[str, RobotStats]
+    rounds: list[dict[str, Any]]
+    rooms_searched: list[str]
+    coverage: dict[str, float]
+    events: list[Record] = field(repr=False)
+    wall_time: float = 0.0
+
+    @property
+    def found(self) -> bool:
+        return self.outcome == "found"
+
+    @property
+    def realtime_factor(self) -> float:
+        return self.end_time / self.wall_time if self.wall_time > 0 else float("inf")
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready summary; wall time is left out so that the file is reproducible."""
+        data = asdict(self)
+        data.pop("events")
+        data.pop("wall_time")
+        return plain(data)  # type: ignore[no-any-return]
+
+
+def build_result(sim: Simulation, outcome: str, wall_time: float) -> RunResult:
+    now = float(sim.env.now)
+    stats = {}
+    for rid, robot in sim.robots.items():
+        mine = [res.status.value for task, res in sim.finished if task.robot == rid]
+        stats[rid] = RobotStats(
+            robot.kind, robot.distance, robot.busy_time, max(now - robot.busy_time, 0.0),
+            mine.count("succeeded"), mine.count("failed") + mine.count("preempted"),
+            mine.count("cancelled"), robot.faulted)
+    coverage = {task.room: float(res.coverage) for task, res in sim.finished
+                if task.room and res.coverage is not None and res.ok}
+    detection = next((r for r in sim.log.records if r["kind"] == "detection"), None)
+    target = {"room": sim.target.room, "position": list(sim.target.position),
+              **sim.target.avatar}
+    return RunResult(
+        mission=sim.mission.spec.name, seed=sim.mission.spec.seed,
+        fidelity=sim.mission.spec.fidelity, outcome=outcome, end_time=now,
+        time_to_find=detection["t"] if detection else None,
+        found_by=detection["robot"] if detection else None, target=target, robots=stats,
+        rounds=sim.rounds, rooms_searched=list(sim.searched), coverage=coverage,
+        events=sim.log.records, wall_time=wall_time)

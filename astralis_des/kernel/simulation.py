@@ -1,0 +1,198 @@
+"""A :class:`Simulation` runs one mission: one SimPy environment, no global state."""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import time
+from collections.abc import Callable, Generator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import simpy
+
+from astralis_des.actions import ACTIONS
+from astralis_des.assignment import Agent, Assignment, RoomInfo, Weights, assign
+from astralis_des.cosim import COSIMS
+from astralis_des.kernel.events import EventLog
+from astralis_des.kernel.handler import TaskHandler
+from astralis_des.kernel.result import RunResult, build_result
+from astralis_des.kernel.robot import Robot
+from astralis_des.kernel.tasks import ActionResult, Stop, Task, TaskStatus
+from astralis_des.kernel.timeline import scheduled, search
+from astralis_des.kernel.world_state import draw_rooms, draw_target
+from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.mission.loader import Mission
+from astralis_des.mission.spec import MemberSpec
+from astralis_des.sensing import GeometricSensor, Sighting
+
+log = logging.getLogger(__name__)
+Progress = Callable[[float, float], None]
+
+
+class Simulation:
+    """One mission run. ``run()`` returns a :class:`RunResult`; with ``out_dir`` it also
+    writes ``events.jsonl``, ``summary.json`` and ``recording.rrd`` there."""
+
+    def __init__(self, mission: Mission, *, out_dir: str | Path | None = None,
+                 progress: Progress | None = None) -> None:
+        spec = mission.spec
+        self.mission = mission
+        self.world = mission.world
+        self.env = simpy.Environment()
+        self.log = EventLog(self.env)
+        self.rooms = draw_rooms(mission)
+        self.target = draw_target(mission)
+        self.sensor = GeometricSensor(self.world, np.array(self.target.position))
+        self.cosim = COSIMS.get(spec.fidelity)(self.env)
+        self.found = self.env.event()
+        self.rounds: list[dict[str, Any]] = []
+        self.searched: list[str] = []
+        self.finished: list[tuple[Task, ActionResult]] = []
+        self.out_dir = Path(out_dir) if out_dir is not None else None
+        self._progress = progress
+        self._ids = itertools.count(1)
+        self._started: dict[str, tuple[int, float]] = {}  # robot -> running task, its start
+        self._handlers: dict[str, TaskHandler] = {}
+        self.robots = {m.id: self._make_robot(m) for m in spec.team}
+
+    # -- set-up ----------------------------------------------------------------------------
+    def _make_robot(self, member: MemberSpec) -> Robot:
+        d = KIND_DEFAULTS[member.kind]
+        height = member.height or d.height
+        if isinstance(member.start, str):
+            start = np.array(self.world.rooms[member.start].center)
+        else:
+            start = np.array(member.start, dtype=float)
+        start = start + np.array([0.0, 0.0, height])
+        robot = Robot(member.id, member.kind, member.speed or d.speed,
+                      member.detection_radius or d.detection_radius, height, start)
+        robot.trail_t.append(0.0)
+        robot.trail_p.append(start.copy())
+
+        def run(task: Task) -> Generator[simpy.Event, Any, ActionResult]:
+            return self._run_action(robot, task)
+
+        def changed(task: Task, result: ActionResult | None) -> None:
+            self._task_changed(robot, task, result)
+
+        self._handlers[member.id] = TaskHandler(self.env, run, changed)
+        robot.handler = self._handlers[member.id]
+        return robot
+
+    def handler(self, robot_id: str) -> TaskHandler:
+        return self._handlers[robot_id]
+
+    # -- tasks -----------------------------------------------------------------------------
+    def enqueue(self, robot_id: str, action: str, room: str | None = None,
+                params: dict[str, Any] | None = None, *, origin: str = "assignment",
+                round: int | None = None, preempt: bool = False) -> simpy.Event:
+        """Queue a task for a robot; the returned event succeeds with its ActionResult."""
+        task = Task(next(self._ids), robot_id, action, room, tuple(sorted((params or {}).items())),
+                    origin, round)
+        self.log.emit("task_queued", robot_id, task=task.id, action=action, room=room,
+                      origin=origin)
+        handler = self._handlers[robot_id]
+        return handler.preempt(task) if preempt else handler.submit(task)
+
+    def _run_action(self, robot: Robot, task: Task) -> Generator[simpy.Event, Any, ActionResult]:
+        start = self.env.now
+        try:
+            action = ACTIONS.get((robot.kind, task.action))
+            outcome = yield from action(self, robot, task)
+        except simpy.Interrupt as stop:
+            cause = stop.cause if isinstance(stop.cause, Stop) else Stop(
+                TaskStatus.CANCELLED, str(stop.cause))
+            self.cosim.halt(robot)
+            outcome = ActionResult(cause.status, cause.message)
+        outcome.start, outcome.end = start, self.env.now
+        return outcome
+
+    def _task_changed(self, robot: Robot, task: Task, result: ActionResult | None) -> None:
+        if result is None:
+            self._started[robot.id] = (task.id, self.env.now)
+            self.log.emit("task_started", robot.id, task=task.id, action=task.action,
+                          room=task.room)
+            return
+        running = self._started.get(robot.id)
+        if running is not None and running[0] == task.id:
+            robot.busy_time += self.env.now - self._started.pop(robot.id)[1]
+        self.finished.append((task, result))
+        payload: dict[str, Any] = {"task": task.id, "action": task.action, "room": task.room,
+                                   "status": result.status.value, "message": result.message,
+                                   "distance": result.distance}
+        if result.coverage is not None:
+            payload["coverage"] = result.coverage
+        self.log.emit("task_finished", robot.id, **payload)
+
+    # -- assignment ------------------------------------------------------------------------
+    def assignment_round(self, segment: str, rooms: list[str], robots: list[Robot]) -> Assignment:
+        cfg = self.mission.spec.assignment
+        agents = [Agent(r.id, r.kind, tuple(r.position(self.env.now).tolist()))  # type: ignore[arg-type]
+                  for r in robots]
+        infos = [RoomInfo(rid, self.world.rooms[rid].center, self.rooms[rid].risk,
+                          self.rooms[rid].messiness) for rid in rooms]
+        weights = Weights(cfg.weights.risk.model_dump(), cfg.weights.messiness.model_dump())
+        plan = assign(agents, infos, weights, strategy=cfg.strategy, solver=cfg.solver,
+                      high_risk=cfg.high_risk, high_messiness=cfg.high_messiness)
+        record = {
+            "round": len(self.rounds) + 1, "t": self.env.now, "segment": segment,
+            "strategy": cfg.strategy, "agents": list(plan.agents), "rooms": list(plan.rooms),
+            "risk": [i.risk for i in infos], "messiness": [i.messiness for i in infos],
+            "costs": plan.costs.tolist(),
+            "matching": [{"agent": p.agent, "room": p.room, "cost": p.cost, "action": p.action}
+                         for p in plan.pairs],
+            "unassigned": list(plan.unassigned),
+        }
+        self.rounds.append(record)
+        self.log.emit("assignment", **{k: v for k, v in record.items() if k != "t"})
+        return plan
+
+    # -- detection -------------------------------------------------------------------------
+    def report_detection(self, robot: Robot, sighting: Sighting) -> None:
+        if self.found.triggered:
+            return
+        self.log.emit("detection", robot.id, target_room=self.target.room,
+                      target_position=self.target.position, robot_position=sighting.robot_position,
+                      distance=sighting.distance, avatar=self.target.avatar)
+        self.found.succeed(robot.id)
+
+    # -- running ---------------------------------------------------------------------------
+    def run(self) -> RunResult:
+        """Run until the target is found, the rooms run out or the time limit; then write."""
+        from astralis_des.sinks import open_sinks
+
+        spec = self.mission.spec
+        wall0 = time.perf_counter()
+        sinks = open_sinks(self, self.out_dir)
+        if self._progress is not None:
+            progress = self._progress
+            self.log.sinks.append(lambda rec: progress(rec["t"], spec.time_limit))
+        self.log.emit("mission_start", mission=spec.name, seed=spec.seed,
+                      fidelity=spec.fidelity, target_room=self.target.room,
+                      team=[m.id for m in spec.team])
+        timeline = self.env.process(search(self))
+        for event in spec.timeline:
+            self.env.process(scheduled(self, event))
+        limit = self.env.timeout(spec.time_limit)
+        outcome = "interrupted"
+        try:
+            self.env.run(until=simpy.AnyOf(self.env, [self.found, timeline, limit]))
+            if self.found.triggered:
+                outcome = "found"
+            elif timeline.triggered:
+                outcome = timeline.value
+            else:
+                outcome = "time_limit"
+        finally:
+            for robot in self.robots.values():
+                self.cosim.halt(robot)
+                if robot.id in self._started:  # still at work when the mission ended
+                    robot.busy_time += self.env.now - self._started.pop(robot.id)[1]
+            self.cosim.close()
+            self.log.emit("mission_end", outcome=outcome)
+            result = build_result(self, outcome, time.perf_counter() - wall0)
+            sinks.close(result)
+        log.info("%s: %s at t=%.1f s", spec.name, outcome, self.env.now)
+        return result

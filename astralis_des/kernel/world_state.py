@@ -1,0 +1,75 @@
+"""What a mission draws from its seed: room properties, the target and its attributes."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from astralis_des.kinds import TARGET_HEIGHT
+from astralis_des.mission.loader import Mission
+
+SOUNDS = ("minimal", "moderate", "loud")
+AVATAR_VALUES: dict[str, tuple[object, ...]] = {
+    "activity": ("sitting", "laying", "patrolling", "idle"),
+    "color": ("yellow", "red", "purple", "blue"),
+    "gender": ("male", "female"),
+    "height": ("tall", "medium", "short"),
+    "tied_to_chair": (True, False),
+}
+# One independent stream per purpose, so drawing more of one never shifts another.
+STREAMS = {"rooms": 1, "target": 2, "avatar": 3}
+
+
+def rng(seed: int, purpose: str) -> np.random.Generator:
+    return np.random.default_rng([seed, STREAMS[purpose]])
+
+
+@dataclass
+class RoomState:
+    risk: float
+    messiness: float
+    sound: str
+
+
+@dataclass(frozen=True)
+class Target:
+    room: str
+    position: tuple[float, float, float]
+    avatar: dict[str, object]
+
+
+def draw_rooms(mission: Mission) -> dict[str, RoomState]:
+    """Uniform risk and messiness in [0, 1] and a sound per room, then the file's overrides."""
+    gen = rng(mission.spec.seed, "rooms")
+    states = {}
+    for room_id in sorted(mission.world.rooms):
+        risk, mess = gen.uniform(0.0, 1.0, size=2)
+        states[room_id] = RoomState(float(risk), float(mess), SOUNDS[int(gen.integers(3))])
+    for room_id, props in mission.spec.rooms.set.items():
+        state = states[room_id]
+        for key, value in props.model_dump(exclude_none=True).items():
+            setattr(state, key, value)
+    return states
+
+
+def draw_target(mission: Mission) -> Target:
+    spec = mission.spec.target
+    gen = rng(mission.spec.seed, "target")
+    candidates = mission.searched_rooms() or sorted(mission.world.rooms)
+    room_id = spec.room or candidates[int(gen.integers(len(candidates)))]
+    room = mission.world.rooms[room_id]
+    if spec.position is not None:
+        position = tuple(float(v) for v in spec.position)
+    else:
+        inset = 0.4
+        x = gen.uniform(room.box.lo[0] + inset, room.box.hi[0] - inset)
+        y = gen.uniform(room.box.lo[1] + inset, room.box.hi[1] - inset)
+        position = (float(x), float(y), room.box.lo[2] + TARGET_HEIGHT)
+    given = spec.avatar.model_dump(exclude_none=True)
+    avatar_gen = rng(mission.spec.seed, "avatar")
+    avatar = {}
+    for key, values in AVATAR_VALUES.items():
+        drawn = values[int(avatar_gen.integers(len(values)))]
+        avatar[key] = given.get(key, drawn)
+    return Target(room_id, position, avatar)  # type: ignore[arg-type]

@@ -1,0 +1,1 @@
+"""Mission files: schema (:mod:`.spec`) and loading with cross-checks (:mod:`.loader`)."""

@@ -1,0 +1,113 @@
+"""Load a mission file: validate it, load its world, and check every reference in it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from astralis_des.errors import InputError, suggest
+from astralis_des.mission.spec import CommandEvent, MissionSpec
+from astralis_des.registry import UnknownEntry
+from astralis_des.validation import validate
+from astralis_des.world.build import load_world
+from astralis_des.world.model import World
+from astralis_des.yamlio import KeyPath, LocatedYaml, load_yaml
+
+
+@dataclass(frozen=True)
+class Mission:
+    """A validated mission with its world; what a :class:`Simulation` runs."""
+
+    spec: MissionSpec
+    world: World
+    path: Path | None = None
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+    def with_changes(self, **changes: Any) -> Mission:
+        """A copy with top-level spec fields replaced (e.g. ``seed=3``), re-validated."""
+        data = self.spec.model_dump()
+        data.update(changes)
+        return replace(self, spec=MissionSpec.model_validate(data))
+
+    def searched_rooms(self) -> list[str]:
+        """Rooms of the searched buildings or segments, in search order."""
+        return [r for seg in self.searched_segments() for r in self.world.segments[seg].rooms]
+
+    def searched_segments(self) -> list[str]:
+        order: list[str] = []
+        for entry in self.spec.assignment.search:
+            segs = (self.world.segment_order(entry) if entry in self.world.buildings
+                    else [entry])
+            order.extend(s for s in segs if s not in order)
+        return order
+
+
+def load_mission(path: str | Path) -> Mission:
+    """Read a mission file; any problem is an :class:`InputError` naming file, line and key."""
+    doc = load_yaml(path)
+    spec = validate(MissionSpec, doc)
+    world_path = (doc.file.parent / spec.world).resolve()
+    if not world_path.is_file():
+        raise doc.error(("world",), f"no such world file: {world_path}")
+    world = load_world(world_path)
+    _check_references(spec, world, doc)
+    return Mission(spec, world, doc.file)
+
+
+def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None:
+    from astralis_des.actions import ACTIONS
+    from astralis_des.assignment.strategies import STRATEGIES
+
+    def room(value: str, path: KeyPath) -> None:
+        if value not in world.rooms:
+            raise doc.error(path, f"no room '{value}' in world '{world.name}'; "
+                            f"{suggest(value, world.rooms)}")
+
+    try:
+        STRATEGIES.get(spec.assignment.strategy)
+    except UnknownEntry as exc:
+        raise doc.error(("assignment", "strategy"), str(exc)) from None
+    places = {*world.buildings, *world.segments}
+    for i, entry in enumerate(spec.assignment.search):
+        if entry not in places:
+            raise doc.error(("assignment", "search", i),
+                            f"'{entry}' is neither a building nor a segment; "
+                            f"{suggest(entry, places)}")
+    for room_id in spec.rooms.set:
+        room(room_id, ("rooms", "set", room_id))
+    if spec.target.room is not None:
+        room(spec.target.room, ("target", "room"))
+        if spec.target.position is not None and not world.rooms[spec.target.room].box.contains(
+                spec.target.position):
+            raise doc.error(("target", "position"),
+                            f"{list(spec.target.position)} is not inside room {spec.target.room}")
+    elif spec.target.position is not None:
+        raise doc.error(("target", "position"), "a target position needs target.room as well")
+    kinds = {m.id: m.kind for m in spec.team}
+    for i, member in enumerate(spec.team):
+        if isinstance(member.start, str):
+            room(member.start, ("team", i, "start"))
+        else:
+            try:
+                world.router.place_of(member.start)
+            except InputError as exc:
+                raise doc.error(("team", i, "start"), exc.message) from None
+    for i, event in enumerate(spec.timeline):
+        robot = getattr(event, "robot", None)
+        if robot is not None and robot not in kinds:
+            raise doc.error(("timeline", i, "robot"),
+                            f"no robot '{robot}' in the team; {suggest(robot, kinds)}")
+        if getattr(event, "room", None) is not None:
+            room(event.room, ("timeline", i, "room"))  # type: ignore[union-attr]
+        if isinstance(event, CommandEvent):
+            try:
+                ACTIONS.get((kinds[event.robot], event.action))
+            except UnknownEntry as exc:
+                raise doc.error(("timeline", i, "action"), str(exc)) from None
+    if spec.timeline and max(e.at for e in spec.timeline) > spec.time_limit:
+        late = max(range(len(spec.timeline)), key=lambda k: spec.timeline[k].at)
+        raise doc.error(("timeline", late, "at"), "this event comes after time_limit")

@@ -1,0 +1,155 @@
+"""The mission file's schema. Unknown keys are refused; defaults are what a user expects."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import (
+    BaseModel, ConfigDict, Field, NonNegativeFloat, PositiveFloat, model_validator,
+)
+
+Vec3 = tuple[float, float, float]
+Kind = Literal["uav", "ugv", "human"]
+Unit = Annotated[float, Field(ge=0.0, le=1.0)]
+Sound = Literal["minimal", "moderate", "loud"]
+
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class MemberSpec(Strict):
+    """One agent of the team."""
+
+    id: str = Field(pattern=r"^[A-Za-z][A-Za-z0-9_-]*$")
+    kind: Kind
+    start: Vec3 | str = Field(description="[x, y, z] in metres, or a room id")
+    speed: PositiveFloat | None = Field(None, description="m/s; default by kind")
+    detection_radius: PositiveFloat | None = Field(None, description="m; default by kind")
+    height: PositiveFloat | None = Field(
+        None, description="m above the floor of its sensor (UAV: flight altitude)")
+
+
+class RoomProps(Strict):
+    risk: Unit | None = None
+    messiness: Unit | None = None
+    sound: Sound | None = None
+
+
+class RoomsSpec(Strict):
+    """Room properties: drawn from the mission seed (uniform in [0, 1]), then overridden."""
+
+    set: dict[str, RoomProps] = Field(default_factory=dict)
+
+
+class AvatarSpec(Strict):
+    """The target's attributes (the paper's Table II); unset ones are drawn from the seed."""
+
+    activity: Literal["sitting", "laying", "patrolling", "idle"] | None = None
+    color: Literal["yellow", "red", "purple", "blue"] | None = None
+    gender: Literal["male", "female"] | None = None
+    height: Literal["tall", "medium", "short"] | None = None
+    tied_to_chair: bool | None = None
+
+
+class TargetSpec(Strict):
+    room: str | None = Field(None, description="room id; drawn from the searched rooms if unset")
+    position: Vec3 | None = Field(None, description="drawn inside the room if unset")
+    avatar: AvatarSpec = AvatarSpec()
+
+
+class KindWeights(Strict):
+    human: NonNegativeFloat = 0.0
+    uav: NonNegativeFloat = 0.0
+    ugv: NonNegativeFloat = 0.0
+
+
+class WeightsSpec(Strict):
+    """Eq. 1's W1 (on risk) and W2 (on messiness), per agent kind."""
+
+    risk: KindWeights = KindWeights(human=10.0, uav=5.0, ugv=0.0)
+    messiness: KindWeights = KindWeights(human=10.0, uav=0.0, ugv=5.0)
+
+
+class AssignmentSpec(Strict):
+    strategy: str = "mixed"
+    weights: WeightsSpec = WeightsSpec()
+    high_risk: Unit = 0.5
+    high_messiness: Unit = 0.5
+    solver: Literal["scipy", "networkx"] = "scipy"
+    search: list[str] = Field(
+        default_factory=lambda: ["A"], min_length=1,
+        description="buildings or segment ids to search, in order; each round takes one segment")
+    max_attempts: int = Field(2, ge=1, description="rounds a room may be tried in")
+
+
+class _At(Strict):
+    at: NonNegativeFloat = Field(description="simulated seconds from the start")
+
+
+class FaultEvent(_At):
+    event: Literal["fault"]
+    robot: str
+    reason: str = "fault"
+
+
+class RecoverEvent(_At):
+    event: Literal["recover"]
+    robot: str
+
+
+class RoomChangeEvent(_At):
+    event: Literal["room_change"]
+    room: str
+    risk: Unit | None = None
+    messiness: Unit | None = None
+    sound: Sound | None = None
+
+
+class CommandEvent(_At):
+    event: Literal["command"]
+    robot: str
+    action: str
+    room: str | None = None
+    params: dict[str, float | str] = Field(default_factory=dict)
+    preempt: bool = Field(False, description="run now, interrupting the current task")
+
+
+class CancelEvent(_At):
+    event: Literal["cancel"]
+    robot: str
+
+
+TimelineEvent = Annotated[
+    FaultEvent | RecoverEvent | RoomChangeEvent | CommandEvent | CancelEvent,
+    Field(discriminator="event"),
+]
+
+
+class OutputsSpec(Strict):
+    dir: str | None = Field(None, description="default: out/<mission name>")
+    events: bool = True
+    summary: bool = True
+    recording: bool = True
+
+
+class MissionSpec(Strict):
+    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
+    world: str = Field(description="world file, relative to the mission file")
+    seed: int = 0
+    fidelity: Literal["kinematic"] = "kinematic"
+    time_limit: PositiveFloat = 3600.0
+    team: list[MemberSpec] = Field(min_length=1)
+    rooms: RoomsSpec = RoomsSpec()
+    target: TargetSpec = TargetSpec()
+    assignment: AssignmentSpec = AssignmentSpec()
+    timeline: list[TimelineEvent] = Field(default_factory=list)
+    outputs: OutputsSpec = OutputsSpec()
+
+    @model_validator(mode="after")
+    def _unique_ids(self) -> MissionSpec:
+        ids = [m.id for m in self.team]
+        duplicates = sorted({i for i in ids if ids.count(i) > 1})
+        if duplicates:
+            raise ValueError(f"team ids must be unique; repeated: {', '.join(duplicates)}")
+        return self

@@ -1,0 +1,89 @@
+"""Where a run's outputs go: the event log (JSONL), the summary (JSON), the Rerun recording."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
+
+from astralis_des.kernel.events import Record
+
+if TYPE_CHECKING:
+    from astralis_des.kernel.result import RunResult
+    from astralis_des.kernel.simulation import Simulation
+
+
+class Output(Protocol):
+    def on_event(self, record: Record) -> None: ...
+    def close(self, result: RunResult) -> None: ...
+
+
+class Outputs:
+    """The open outputs of one run; each sees every event, then the result."""
+
+    def __init__(self, outputs: list[Output]) -> None:
+        self.outputs = outputs
+
+    def on_event(self, record: Record) -> None:
+        for out in self.outputs:
+            out.on_event(record)
+
+    def close(self, result: RunResult) -> None:
+        for out in self.outputs:
+            out.close(result)
+
+
+class JsonlWriter:
+    """``events.jsonl``: one event a line, written as it happens, so an interrupted run keeps
+    every complete line."""
+
+    def __init__(self, path: Path) -> None:
+        self._file = path.open("w", encoding="utf-8")
+
+    def on_event(self, record: Record) -> None:
+        self._file.write(dumps(record) + "\n")
+
+    def close(self, result: RunResult) -> None:
+        self._file.close()
+
+
+class SummaryWriter:
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def on_event(self, record: Record) -> None:
+        pass
+
+    def close(self, result: RunResult) -> None:
+        write_atomic(self.path, json.dumps(result.summary(), indent=2) + "\n")
+
+
+def dumps(record: Any) -> str:
+    return json.dumps(record, separators=(",", ":"), ensure_ascii=False)
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write through a temporary file and rename, so no reader sees half a file."""
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def open_sinks(sim: Simulation, out_dir: Path | None) -> Outputs:
+    """Open what the mission's ``outputs`` asks for under ``out_dir`` (nothing without one)."""
+    outputs: list[Output] = []
+    if out_dir is not None:
+        cfg = sim.mission.spec.outputs
+        out_dir.mkdir(parents=True, exist_ok=True)
+        if cfg.events:
+            outputs.append(JsonlWriter(out_dir / "events.jsonl"))
+        if cfg.summary:
+            outputs.append(SummaryWriter(out_dir / "summary.json"))
+        if cfg.recording:
+            from astralis_des.sinks.recording import RerunRecorder
+
+            outputs.append(RerunRecorder(sim, out_dir / "recording.rrd"))
+    sinks = Outputs(outputs)
+    sim.log.sinks.append(sinks.on_event)
+    return sinks

@@ -1,0 +1,26 @@
+"""Entity paths of a recording, in one place: ``world/...``, ``robots/<id>/...``, ``mission/...``."""
+
+from __future__ import annotations
+
+TIMELINE = "sim_time"
+WORLD_SOLIDS = "world/solids"
+WORLD_ROOMS = "world/rooms"
+WORLD_TARGET = "world/target"
+MISSION_EVENTS = "mission/events"
+MISSION_ROUNDS = "mission/assignment"
+
+
+def robot(robot_id: str) -> str:
+    return f"robots/{robot_id}"
+
+
+def robot_pose(robot_id: str) -> str:
+    return f"robots/{robot_id}/pose"
+
+
+def robot_trail(robot_id: str) -> str:
+    return f"robots/{robot_id}/trail"
+
+
+def robot_task(robot_id: str) -> str:
+    return f"robots/{robot_id}/task"

@@ -1,0 +1,111 @@
+"""Pydantic validation at the edge, with errors that name the file, line and key."""
+
+from __future__ import annotations
+
+import types
+import typing
+from typing import Any, TypeVar
+
+from pydantic import BaseModel, ValidationError
+
+from astralis_des.errors import InputError, suggest
+from astralis_des.yamlio import KeyPath, LocatedYaml
+
+M = TypeVar("M", bound=BaseModel)
+
+
+def validate(model: type[M], doc: LocatedYaml, *, context: dict[str, Any] | None = None) -> M:
+    """Validate ``doc.data`` as ``model``; the first error becomes an :class:`InputError`."""
+    try:
+        return model.model_validate(doc.data, context=context)
+    except ValidationError as exc:
+        raise _to_input_error(model, doc, exc) from None
+
+
+def _to_input_error(model: type[BaseModel], doc: LocatedYaml, exc: ValidationError) -> InputError:
+    error = _most_useful(exc.errors())
+    path: KeyPath = tuple(p for p in error["loc"] if isinstance(p, str | int))
+    path = _drop_union_tags(model, path)
+    if error["type"] == "extra_forbidden":
+        key = str(path[-1])
+        owner = _model_at(model, path[:-1])
+        fields = list(owner.model_fields) if owner is not None else []
+        return doc.error(path, f"unknown key '{key}'; {suggest(key, fields)}")
+    if error["type"] == "missing":
+        return doc.error(path, "this key is required")
+    message = str(error["msg"])
+    if message.startswith("Value error, "):
+        message = message[len("Value error, "):]
+    if error["type"] not in ("value_error", "assertion_error") and "input" in error:
+        value = error["input"]
+        if isinstance(value, str | int | float | bool):
+            message += f" (got {value!r})"
+    return doc.error(path, message)
+
+
+def _most_useful(errors: list[Any]) -> Any:
+    """Prefer an unknown-key error, then the deepest one: it points closest to the mistake."""
+    unknown = [e for e in errors if e["type"] == "extra_forbidden"]
+    if unknown:
+        return unknown[0]
+    return max(errors, key=lambda e: len(e["loc"]))
+
+
+def _drop_union_tags(model: type[BaseModel], path: KeyPath) -> KeyPath:
+    """Pydantic puts a union member's name in the location; the file has no such key."""
+    kept: list[str | int] = []
+    current: Any = model
+    for part in path:
+        candidates = _models_in(current)
+        if isinstance(part, str) and candidates and not any(
+            part in c.model_fields for c in candidates
+        ) and any(c.__name__ == part or part.startswith(c.__name__) for c in candidates):
+            current = next(c for c in candidates if part.startswith(c.__name__))
+            continue
+        kept.append(part)
+        current = _step(current, part)
+    return tuple(kept)
+
+
+def _models_in(annotation: Any) -> list[type[BaseModel]]:
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    origin = typing.get_origin(annotation)
+    if origin in (typing.Union, types.UnionType, typing.Annotated):
+        found: list[type[BaseModel]] = []
+        for arg in typing.get_args(annotation):
+            found.extend(_models_in(arg))
+        return found
+    return []
+
+
+def _step(annotation: Any, part: str | int) -> Any:
+    if annotation is None:
+        return None
+    origin = typing.get_origin(annotation)
+    if origin is typing.Annotated:
+        return _step(typing.get_args(annotation)[0], part)
+    if origin in (typing.Union, types.UnionType):
+        for arg in typing.get_args(annotation):
+            stepped = _step(arg, part)
+            if stepped is not None:
+                return stepped
+        return None
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        field = annotation.model_fields.get(str(part))
+        return field.annotation if field is not None else None
+    if origin in (list, tuple) and isinstance(part, int):
+        args = typing.get_args(annotation)
+        return args[0] if args else None
+    if origin is dict:
+        args = typing.get_args(annotation)
+        return args[1] if len(args) == 2 else None
+    return None
+
+
+def _model_at(model: type[BaseModel], path: KeyPath) -> type[BaseModel] | None:
+    current: Any = model
+    for part in path:
+        current = _step(current, part)
+    models = _models_in(current)
+    return models[0] if models else None

@@ -1,0 +1,145 @@
+"""Build a :class:`World` from a world file: rooms, doors, corridors, stairwells and walls.
+
+Every floor of a building repeats one plan: a stairwell at the west end, a corridor along x,
+segments of rooms on its north and south sides, a lobby at the east end with the entrance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+from astralis_des.world.geometry import Box
+from astralis_des.world.model import Building, Door, Room, Segment, Solid, Space, World
+from astralis_des.world.spec import BuildingSpec, WorldSpec
+
+
+@dataclass
+class _Parts:
+    rooms: dict[str, Room]
+    segments: dict[str, Segment]
+    spaces: dict[str, Space]
+    solids: list[Solid]
+
+
+def build_world(spec: WorldSpec) -> World:
+    parts = _Parts({}, {}, {}, [])
+    buildings = {b.id: _add_building(b, parts) for b in spec.buildings}
+    for obstacle in spec.obstacles:
+        cx, cy = obstacle.center
+        sx, sy, sz = obstacle.size
+        box = Box((cx - sx / 2, cy - sy / 2, 0.0), (cx + sx / 2, cy + sy / 2, sz))
+        parts.solids.append(Solid(obstacle.kind, box, obstacle.kind))
+    return World(
+        name=spec.name, site=spec.site.size, buildings=buildings, segments=parts.segments,
+        rooms=parts.rooms, spaces=parts.spaces, solids=tuple(parts.solids),
+        stairs_passable_by={b.id: tuple(b.stairs_passable_by) for b in spec.buildings},
+    )
+
+
+@lru_cache(maxsize=16)
+def load_world(path: Path) -> World:
+    """Read, validate and build a world file; cached, since a world never changes."""
+    from astralis_des.validation import validate
+    from astralis_des.yamlio import load_yaml
+
+    return build_world(validate(WorldSpec, load_yaml(path)))
+
+
+def _add_building(b: BuildingSpec, parts: _Parts) -> Building:
+    ox, oy = b.origin
+    t, h = b.wall_thickness, b.floor_height
+    rw, rd = b.room_size
+    sides = {side: [s for s in b.segments if s.side == side] for side in ("south", "north")}
+    count = {side: sum(s.rooms for s in segs) for side, segs in sides.items()}
+    depth = {side: rd if count[side] else 0.0 for side in sides}
+    x_stair = ox + b.stairwell_width
+    x_east = x_stair + max(count.values()) * rw + b.lobby_length
+    y_lo = oy + depth["south"]  # corridor's south line
+    y_hi = y_lo + b.corridor_width  # corridor's north line
+    y_north = y_hi + depth["north"]
+    top = b.floors * h
+    yc = (y_lo + y_hi) / 2
+
+    for floor in range(1, b.floors + 1):
+        z = (floor - 1) * h
+        inner_top = z + h - t
+        corridor_id = f"{b.id}.{floor}.corridor"
+        parts.spaces[corridor_id] = Space(
+            corridor_id, "corridor", b.id, floor,
+            Box((x_stair, y_lo + t / 2, z), (x_east - t / 2, y_hi - t / 2, inner_top)))
+        doors: dict[str, list[float]] = {"south": [], "north": []}
+        for side, segs in sides.items():
+            x = x_stair
+            for seg_index, seg in enumerate(b.segments, start=1):
+                if seg not in segs:
+                    continue
+                seg_id = f"{b.id}.{floor}.{seg_index}"
+                room_ids = []
+                for r in range(1, seg.rooms + 1):
+                    room_id = f"{seg_id}.{r}"
+                    y0, y1 = (oy, y_lo) if side == "south" else (y_hi, y_north)
+                    door_y = y_lo if side == "south" else y_hi
+                    door = Door((x + rw / 2, door_y, z), 1, b.door_width, b.door_height)
+                    box = Box((x + t / 2, y0 + t / 2, z), (x + rw - t / 2, y1 - t / 2, inner_top))
+                    parts.rooms[room_id] = Room(room_id, b.id, floor, seg_id, box, door,
+                                                corridor_id)
+                    doors[side].append(x + rw / 2)
+                    room_ids.append(room_id)
+                    x += rw
+                parts.segments[seg_id] = Segment(seg_id, b.id, floor, tuple(room_ids))
+        walls = _floor_walls(b, z, x_stair, x_east, y_lo, y_hi, y_north, doors, floor == 1)
+        parts.solids.extend(Solid("wall", w, f"{b.id}.{floor}") for w in walls)
+        slab_x0 = ox if floor == 1 else x_stair  # the stair shaft is open above the ground
+        parts.solids.append(Solid("slab", Box((slab_x0, oy, z - t), (x_east, y_north, z)),
+                                  f"{b.id}.{floor} floor"))
+    parts.solids.append(Solid("slab", Box((ox, oy, top - t), (x_east, y_north, top)),
+                              f"{b.id} roof"))
+    parts.spaces[f"{b.id}.stairwell"] = Space(
+        f"{b.id}.stairwell", "stairwell", b.id, 0,
+        Box((ox + t / 2, oy + t / 2, 0.0), (x_stair - t / 2, y_north - t / 2, top - t)))
+    return Building(b.id, Box((ox, oy, 0.0), (x_east, y_north, top)), b.floors, h,
+                    entrance=(x_east + 1.5, yc, 0.0))
+
+
+def _floor_walls(
+    b: BuildingSpec, z: float, x_stair: float, x_east: float, y_lo: float, y_hi: float,
+    y_north: float, doors: dict[str, list[float]], ground: bool,
+) -> list[Box]:
+    ox, oy = b.origin
+    t, top = b.wall_thickness, z + b.floor_height - b.wall_thickness
+    rw = b.room_size[0]
+
+    def wall(axis: int, at: float, a: float, c: float, gaps: list[float], width: float) -> list[Box]:
+        """Wall on the line ``coord[axis] == at`` from ``a`` to ``c``, with door gaps."""
+        out: list[Box] = []
+        start = a
+        cuts = [(g - width / 2, g + width / 2) for g in sorted(gaps)] + [(c, c)]
+        for lo, hi in cuts:
+            if lo > start:
+                out.append(_wall_box(axis, at, start, lo, z, top, t))
+            if hi > lo:
+                out.append(_wall_box(axis, at, lo, hi, z + b.door_height, top, t))
+            start = hi
+        return out
+
+    walls = wall(1, oy, ox, x_east, [], 0.0) + wall(1, y_north, ox, x_east, [], 0.0)
+    walls += wall(0, ox, oy, y_north, [], 0.0)
+    entrance_width = min(1.6, b.corridor_width - 0.4)
+    walls += wall(0, x_east, oy, y_north, [(y_lo + y_hi) / 2] if ground else [], entrance_width)
+    for side, line, far in (("south", y_lo, oy), ("north", y_hi, y_north)):
+        if not doors[side]:
+            continue
+        walls += wall(1, line, x_stair, x_east, doors[side], b.door_width)
+        lo, hi = sorted((line, far))
+        walls += wall(0, x_stair, lo, hi, [], 0.0)
+        walls += [_wall_box(0, x_stair + k * rw, lo, hi, z, top, t)
+                  for k in range(1, len(doors[side]) + 1)]
+    return walls
+
+
+def _wall_box(axis: int, at: float, a: float, c: float, z0: float, z1: float, t: float) -> Box:
+    if axis == 0:  # the wall is the line x == at
+        return Box((at - t / 2, a, z0), (at + t / 2, c, z1))
+    return Box((a, at - t / 2, z0), (c, at + t / 2, z1))

@@ -1,0 +1,95 @@
+"""Axis-aligned boxes and vectorised segment tests against them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Box:
+    """An axis-aligned box given by its two corners."""
+
+    lo: tuple[float, float, float]
+    hi: tuple[float, float, float]
+
+    @property
+    def center(self) -> tuple[float, float, float]:
+        return (
+            (self.lo[0] + self.hi[0]) / 2, (self.lo[1] + self.hi[1]) / 2,
+            (self.lo[2] + self.hi[2]) / 2,
+        )
+
+    @property
+    def size(self) -> tuple[float, float, float]:
+        return (self.hi[0] - self.lo[0], self.hi[1] - self.lo[1], self.hi[2] - self.lo[2])
+
+    def contains(self, point: FloatArray | tuple[float, ...], margin: float = 0.0) -> bool:
+        p = np.asarray(point, dtype=float)
+        return bool(np.all(p >= np.asarray(self.lo) - margin)
+                    and np.all(p <= np.asarray(self.hi) + margin))
+
+
+def boxes_array(boxes: list[Box]) -> FloatArray:
+    """``(K, 2, 3)`` array of box corners."""
+    if not boxes:
+        return np.zeros((0, 2, 3))
+    return np.array([[b.lo, b.hi] for b in boxes], dtype=float)
+
+
+def segments_hit_boxes(p0: FloatArray, p1: FloatArray, boxes: FloatArray) -> NDArray[np.bool_]:
+    """``(M,)`` mask: does segment ``p0[m] -> p1[m]`` pass through any of ``boxes``?
+
+    Slab test, vectorised over segments and boxes; touching a face counts as a hit.
+    """
+    p0 = np.atleast_2d(np.asarray(p0, dtype=float))
+    p1 = np.atleast_2d(np.asarray(p1, dtype=float))
+    if len(boxes) == 0 or len(p0) == 0:
+        return np.zeros(len(p0), dtype=bool)
+    # Only boxes whose extent meets the segments' common bounding box can be hit.
+    lo = np.minimum(p0.min(axis=0), p1.min(axis=0))
+    hi = np.maximum(p0.max(axis=0), p1.max(axis=0))
+    near = np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1)
+    candidates = boxes[near]
+    if len(candidates) == 0:
+        return np.zeros(len(p0), dtype=bool)
+    d = (p1 - p0)[:, None, :]
+    origin = p0[:, None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / d
+        t_a = (candidates[None, :, 0, :] - origin) * inv
+        t_b = (candidates[None, :, 1, :] - origin) * inv
+    t_near = np.where(np.isnan(t_a), -np.inf, np.minimum(t_a, t_b))
+    t_far = np.where(np.isnan(t_b), np.inf, np.maximum(t_a, t_b))
+    # A zero direction component: the segment is inside the slab or never enters it.
+    parallel = d == 0.0
+    inside = (origin >= candidates[None, :, 0, :]) & (origin <= candidates[None, :, 1, :])
+    t_near = np.where(parallel, np.where(inside, -np.inf, np.inf), t_near)
+    t_far = np.where(parallel, np.where(inside, np.inf, -np.inf), t_far)
+    enter = t_near.max(axis=2)
+    leave = t_far.min(axis=2)
+    hit = (enter <= leave) & (leave >= 0.0) & (enter <= 1.0)
+    return np.asarray(hit.any(axis=1))
+
+
+def polyline_length(points: FloatArray) -> float:
+    if len(points) < 2:
+        return 0.0
+    return float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())
+
+
+def resample(points: FloatArray, step: float) -> tuple[FloatArray, FloatArray]:
+    """Points every ``step`` metres along a polyline, and their arc lengths."""
+    points = np.asarray(points, dtype=float)
+    if len(points) < 2:
+        return points.copy(), np.zeros(len(points))
+    seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    total = cum[-1]
+    s = np.append(np.arange(0.0, total, step), total) if total > 0 else np.zeros(1)
+    out = np.column_stack([np.interp(s, cum, points[:, k]) for k in range(points.shape[1])])
+    return out, s

@@ -1,0 +1,150 @@
+"""The world a mission runs in: buildings > floors > segments > rooms, and the outdoor site.
+
+A :class:`World` is immutable once built and may be shared by many simulations.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from astralis_des.world.geometry import Box, FloatArray, boxes_array
+
+if TYPE_CHECKING:
+    from astralis_des.world.routing import Router
+
+
+@dataclass(frozen=True)
+class Door:
+    """An opening in a wall: ``center`` on the wall line at floor height."""
+
+    center: tuple[float, float, float]
+    normal_axis: int  # 0: the wall is normal to x, 1: normal to y
+    width: float
+    height: float
+
+
+@dataclass(frozen=True)
+class Room:
+    """A searchable room; ``id`` reads building.floor.segment.room, e.g. ``A.2.1.3``."""
+
+    id: str
+    building: str
+    floor: int
+    segment: str
+    box: Box
+    door: Door
+    corridor: str
+
+    @property
+    def center(self) -> tuple[float, float, float]:
+        """Centre of the floor of the room."""
+        c = self.box.center
+        return (c[0], c[1], self.box.lo[2])
+
+    @property
+    def area(self) -> float:
+        sx, sy, _ = self.box.size
+        return sx * sy
+
+    def door_point(self, side: str = "corridor", offset: float = 0.3) -> tuple[float, float, float]:
+        """A point ``offset`` beyond the door's wall, on the room or the corridor side."""
+        axis = self.door.normal_axis
+        inward = 1.0 if self.box.center[axis] > self.door.center[axis] else -1.0
+        edge = self.box.lo[axis] if inward > 0 else self.box.hi[axis]
+        gap = abs(edge - self.door.center[axis]) + offset
+        point = list(self.door.center)
+        point[axis] += inward * gap if side == "room" else -inward * gap
+        return (point[0], point[1], point[2])
+
+
+@dataclass(frozen=True)
+class Space:
+    """A convex walkable volume (corridor, stairwell): straight lines inside it are free."""
+
+    id: str
+    kind: str
+    building: str
+    floor: int
+    box: Box
+
+
+@dataclass(frozen=True)
+class Solid:
+    """Static geometry: a wall, slab or outdoor obstacle, as an axis-aligned box."""
+
+    kind: str
+    box: Box
+    label: str = ""
+
+
+@dataclass(frozen=True)
+class Segment:
+    id: str
+    building: str
+    floor: int
+    rooms: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Building:
+    id: str
+    footprint: Box  # full height
+    floors: int
+    floor_height: float
+    entrance: tuple[float, float, float]  # just outside the entrance door, at ground level
+
+
+@dataclass(frozen=True)
+class World:
+    name: str
+    site: tuple[float, float]
+    buildings: dict[str, Building]
+    segments: dict[str, Segment]
+    rooms: dict[str, Room]
+    spaces: dict[str, Space]
+    solids: tuple[Solid, ...]
+    stairs_passable_by: dict[str, tuple[str, ...]] = field(default_factory=dict)
+
+    @cached_property
+    def solid_array(self) -> FloatArray:
+        """``(K, 2, 3)`` corners of every solid, for vectorised line-of-sight tests."""
+        return boxes_array([s.box for s in self.solids])
+
+    @cached_property
+    def router(self) -> Router:
+        from astralis_des.world.routing import Router
+
+        return Router(self)
+
+    def contains(self, point: tuple[float, ...] | FloatArray) -> bool:
+        x, y = float(point[0]), float(point[1])
+        return 0.0 <= x <= self.site[0] and 0.0 <= y <= self.site[1]
+
+    def room_at(self, point: tuple[float, ...] | FloatArray) -> Room | None:
+        for room in self.rooms.values():
+            if room.box.contains(point, margin=1e-6):
+                return room
+        return None
+
+    def line_of_sight(self, p0: FloatArray, p1: FloatArray) -> np.ndarray:
+        """``(M,)`` mask, true where the segment ``p0[m] -> p1[m]`` meets no solid."""
+        from astralis_des.world.geometry import segments_hit_boxes
+
+        return ~segments_hit_boxes(p0, p1, self.solid_array)
+
+    @property
+    def area(self) -> float:
+        return self.site[0] * self.site[1]
+
+    def segment_order(self, building: str | None = None) -> list[str]:
+        """Segments in id order (floor by floor), optionally of one building."""
+        ids = [s for s, seg in self.segments.items() if building in (None, seg.building)]
+        return sorted(ids, key=_natural_key)
+
+
+def _natural_key(text: str) -> list[object]:
+    return [int(p) if p.isdigit() else p for p in text.split(".")]

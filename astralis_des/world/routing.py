@@ -1,0 +1,178 @@
+"""Routes through the world for the kinematic fidelity: a graph of rooms, doors, corridors,
+stairwells, entrances and outdoor corners, solved all-pairs once per world and agent kind."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import shortest_path
+
+from astralis_des.errors import InputError
+from astralis_des.world.geometry import FloatArray, segments_hit_boxes
+from astralis_des.world.model import World
+
+KINDS = ("uav", "ugv", "human")
+OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
+STAIR_RUN_FACTOR = 2.0  # horizontal run of a flight of stairs per metre of rise
+
+
+class Router:
+    """Shortest routes between arbitrary points, for each agent kind."""
+
+    def __init__(self, world: World) -> None:
+        self.world = world
+        self.names: list[str] = []
+        self.index: dict[str, int] = {}
+        self._pos: list[tuple[float, float, float]] = []
+        self._edges: list[tuple[int, int, dict[str, float]]] = []
+        self.corridor_nodes: dict[str, list[int]] = {}
+        self.outdoor_nodes: list[int] = []
+        self._footprints = self._outdoor_blockers()
+        self._build()
+        self.positions = np.array(self._pos, dtype=float)
+        self.dist: dict[str, FloatArray] = {}
+        self.pred: dict[str, np.ndarray] = {}
+        n = len(self.names)
+        for kind in KINDS:
+            rows, cols, vals = [], [], []
+            for u, v, lengths in self._edges:
+                if kind in lengths:
+                    rows += [u, v]
+                    cols += [v, u]
+                    vals += [lengths[kind]] * 2
+            graph = csr_matrix((vals, (rows, cols)), shape=(n, n))
+            self.dist[kind], self.pred[kind] = shortest_path(
+                graph, method="D", directed=False, return_predecessors=True)
+
+    # -- graph construction -------------------------------------------------------------
+    def _node(self, name: str, pos: tuple[float, float, float]) -> int:
+        self.index[name] = len(self.names)
+        self.names.append(name)
+        self._pos.append(pos)
+        return self.index[name]
+
+    def _edge(self, u: int, v: int, kinds: tuple[str, ...] = KINDS,
+              length: float | None = None) -> None:
+        d = length if length is not None else math.dist(self._pos[u], self._pos[v])
+        self._edges.append((u, v, dict.fromkeys(kinds, d)))
+
+    def _build(self) -> None:
+        w = self.world
+        for corr in (s for s in w.spaces.values() if s.kind == "corridor"):
+            box = corr.box
+            yc, z = (box.lo[1] + box.hi[1]) / 2, box.lo[2]
+            rooms = [r for r in w.rooms.values() if r.corridor == corr.id]
+            xs = sorted({box.lo[0] + 0.5, box.hi[0] - 0.75, *(r.door.center[0] for r in rooms)})
+            nodes = [self._node(f"{corr.id}:{i}", (x, yc, z)) for i, x in enumerate(xs)]
+            for u, v in zip(nodes, nodes[1:], strict=False):
+                self._edge(u, v)
+            self.corridor_nodes[corr.id] = nodes
+            for room in rooms:
+                door = self._node(f"{room.id}:door", room.door.center)
+                centre = self._node(room.id, room.center)
+                self._edge(centre, door)
+                self._edge(door, nodes[xs.index(room.door.center[0])])
+        for b in w.buildings.values():
+            stair = w.spaces[f"{b.id}.stairwell"].box
+            sx = (stair.lo[0] + stair.hi[0]) / 2
+            passable = w.stairs_passable_by.get(b.id, KINDS)
+            previous = None
+            for floor in range(1, b.floors + 1):
+                corridor = self.corridor_nodes[f"{b.id}.{floor}.corridor"]
+                z = (floor - 1) * b.floor_height
+                node = self._node(f"{b.id}.{floor}.stair", (sx, self._pos[corridor[0]][1], z))
+                self._edge(node, corridor[0])
+                if previous is not None:
+                    rise = b.floor_height
+                    lengths = {k: rise if k == "uav" else math.hypot(rise, STAIR_RUN_FACTOR * rise)
+                               for k in passable}
+                    self._edges.append((previous, node, lengths))
+                previous = node
+            outside = self._node(f"{b.id}:entrance", b.entrance)
+            self._edge(outside, self.corridor_nodes[f"{b.id}.1.corridor"][-1])
+            self.outdoor_nodes.append(outside)
+        for solid in [b.footprint for b in w.buildings.values()] + [
+            s.box for s in w.solids if s.kind not in ("wall", "slab")
+        ]:
+            for cx in (solid.lo[0] - OUTDOOR_MARGIN, solid.hi[0] + OUTDOOR_MARGIN):
+                for cy in (solid.lo[1] - OUTDOOR_MARGIN, solid.hi[1] + OUTDOOR_MARGIN):
+                    if w.contains((cx, cy)):
+                        name = f"corner:{len(self.outdoor_nodes)}"
+                        self.outdoor_nodes.append(self._node(name, (cx, cy, 0.0)))
+        pts = np.array([self._pos[i] for i in self.outdoor_nodes])
+        for a in range(len(pts)):
+            others = np.arange(a + 1, len(pts))
+            clear = self._outdoor_clear(np.repeat(pts[a:a + 1], len(others), 0), pts[others])
+            for b_idx in others[clear]:
+                self._edge(self.outdoor_nodes[a], self.outdoor_nodes[b_idx])
+
+    def _outdoor_blockers(self) -> FloatArray:
+        boxes = [b.footprint for b in self.world.buildings.values()]
+        boxes += [s.box for s in self.world.solids if s.kind not in ("wall", "slab")]
+        return np.array([[[*b.lo[:2], -1.0], [*b.hi[:2], 1.0]] for b in boxes]).reshape(-1, 2, 3)
+
+    def _outdoor_clear(self, p0: FloatArray, p1: FloatArray) -> np.ndarray:
+        flat0 = np.column_stack([p0[:, :2], np.zeros(len(p0))])
+        flat1 = np.column_stack([p1[:, :2], np.zeros(len(p1))])
+        return ~segments_hit_boxes(flat0, flat1, self._footprints)
+
+    # -- queries --------------------------------------------------------------------------
+    def place_of(self, point: FloatArray | tuple[float, ...]) -> str:
+        """Name of the convex place holding ``point``: a room id, a space id or ``outdoor``."""
+        p = np.asarray(point, dtype=float)
+        room = self.world.room_at(p)
+        if room is not None:
+            return room.id
+        for space in self.world.spaces.values():
+            if space.box.contains(p, margin=0.05):
+                return space.id
+        if not self.world.contains(p):
+            raise InputError(f"point {tuple(np.round(p, 2))} is outside the world")
+        if not self._outdoor_clear(p[None, :], p[None, :])[0]:
+            raise InputError(f"point {tuple(np.round(p, 2))} is inside a building or obstacle")
+        return "outdoor"
+
+    def _entries(self, p: FloatArray, place: str) -> list[int]:
+        if place in self.world.rooms:
+            return [self.index[place], self.index[f"{place}:door"]]
+        if place in self.corridor_nodes:
+            return self.corridor_nodes[place]
+        if place.endswith(".stairwell"):
+            b = self.world.buildings[place.split(".")[0]]
+            floor = min(b.floors, max(1, int(p[2] // b.floor_height) + 1))
+            return [self.index[f"{b.id}.{floor}.stair"]]
+        nodes = np.array(self.outdoor_nodes)
+        pts = self.positions[nodes]
+        clear = self._outdoor_clear(np.repeat(p[None, :], len(pts), 0), pts)
+        return [int(n) for n in nodes[clear]]
+
+    def route(self, start: FloatArray | tuple[float, ...], goal: FloatArray | tuple[float, ...],
+              kind: str) -> FloatArray | None:
+        """Waypoints from ``start`` to ``goal`` at floor level, or ``None`` if unreachable."""
+        p = np.asarray(start, dtype=float)
+        q = np.asarray(goal, dtype=float)
+        p_place, q_place = self.place_of(p), self.place_of(q)
+        if p_place == q_place and (p_place != "outdoor" or self._outdoor_clear(
+                p[None, :], q[None, :])[0]):
+            return np.array([p, q])
+        a = self._entries(p, p_place)
+        b = self._entries(q, q_place)
+        if not a or not b:
+            return None
+        da = np.linalg.norm(self.positions[a] - p, axis=1)
+        db = np.linalg.norm(self.positions[b] - q, axis=1)
+        total = da[:, None] + self.dist[kind][np.ix_(a, b)] + db[None, :]
+        i, j = np.unravel_index(int(np.argmin(total)), total.shape)
+        if not np.isfinite(total[i, j]):
+            return None
+        nodes = self._walk(a[i], b[j], kind)
+        return np.vstack([p, self.positions[nodes], q])
+
+    def _walk(self, u: int, v: int, kind: str) -> list[int]:
+        pred = self.pred[kind][u]
+        nodes = [v]
+        while nodes[-1] != u:
+            nodes.append(int(pred[nodes[-1]]))
+        return nodes[::-1]

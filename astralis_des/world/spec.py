@@ -1,0 +1,71 @@
+"""The world file's schema (``worlds/*.yaml``), validated at the edge."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, model_validator
+
+Vec2 = tuple[float, float]
+Vec3 = tuple[float, float, float]
+KINDS = ("uav", "ugv", "human")
+
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class SegmentSpec(Strict):
+    side: Literal["north", "south"]
+    rooms: PositiveInt = Field(description="rooms in this segment, laid along the corridor")
+
+
+class BuildingSpec(Strict):
+    id: str = Field(pattern=r"^[A-Za-z][A-Za-z0-9]*$", description="letter(s) used in room ids")
+    origin: Vec2 = Field(description="south-west corner of the footprint, metres")
+    floors: PositiveInt
+    floor_height: PositiveFloat = 3.5
+    wall_thickness: PositiveFloat = 0.2
+    room_size: tuple[PositiveFloat, PositiveFloat] = Field(
+        (4.0, 7.0), description="room width along the corridor and depth away from it")
+    corridor_width: PositiveFloat = 2.5
+    stairwell_width: PositiveFloat = 4.0
+    lobby_length: PositiveFloat = 4.0
+    door_width: PositiveFloat = 1.0
+    door_height: PositiveFloat = 2.1
+    stairs_passable_by: list[Literal["uav", "ugv", "human"]] = Field(
+        default_factory=lambda: ["uav", "ugv", "human"],
+        description="who can change floors (stairs with a vehicle ramp by default)")
+    segments: list[SegmentSpec] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _door_fits(self) -> BuildingSpec:
+        if self.door_width >= self.room_size[0]:
+            raise ValueError("door_width must be smaller than the room width")
+        if self.door_height >= self.floor_height:
+            raise ValueError("door_height must be lower than floor_height")
+        return self
+
+
+class ObstacleSpec(Strict):
+    kind: str = Field(description="what it is (tree, vehicle, lamp_post, ...), shown in replays")
+    center: Vec2
+    size: Vec3 = Field(description="box extent x, y, z in metres")
+
+
+class SiteSpec(Strict):
+    size: tuple[PositiveFloat, PositiveFloat] = Field(description="outdoor area, metres")
+
+
+class WorldSpec(Strict):
+    name: str
+    site: SiteSpec
+    buildings: list[BuildingSpec] = Field(min_length=1)
+    obstacles: list[ObstacleSpec] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _unique_ids(self) -> WorldSpec:
+        ids = [b.id for b in self.buildings]
+        if len(ids) != len(set(ids)):
+            raise ValueError(f"building ids must be unique, got {ids}")
+        return self
