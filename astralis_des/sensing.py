@@ -49,7 +49,8 @@ class GeometricSensor:
         if not clear.any():
             return None
         i = int(near[np.argmax(clear)])
-        return Sighting(float(times[i]), tuple(pts[i].tolist()), float(d[i]))  # type: ignore[arg-type]
+        x, y, z = (float(v) for v in pts[i])
+        return Sighting(float(times[i]), (x, y, z), float(d[i]))
 
     def coverage(self, robot: Robot, points: FloatArray, room: Room) -> float:
         """Share of ``room``'s floor cells seen from any point of the path ``points``."""

@@ -54,7 +54,8 @@ def at_height(robot: Robot, floor_points: FloatArray) -> FloatArray:
     return pts
 
 
-def route(ctx: Context, robot: Robot, goal_floor: FloatArray | tuple[float, ...]) -> FloatArray | None:
+def route(ctx: Context, robot: Robot,
+          goal_floor: FloatArray | tuple[float, ...]) -> FloatArray | None:
     """Route from where the robot is to a floor-level goal, at the robot's sensor height."""
     here = robot.position(ctx.env.now) - np.array([0.0, 0.0, robot.height])
     pts = ctx.world.router.route(here, goal_floor, robot.kind)

@@ -5,7 +5,12 @@ from __future__ import annotations
 from astralis_des.actions import ACTIONS
 from astralis_des.actions import coverage as cov
 from astralis_des.actions.common import (
-    ActionGen, Context, failed, plane_to_floor, room_of, search_path,
+    ActionGen,
+    Context,
+    failed,
+    plane_to_floor,
+    room_of,
+    search_path,
 )
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task

@@ -1,11 +1,19 @@
-"""UAV actions of Table I: hover, inward and outward spiral search, vertical and horizontal sweep."""
+"""UAV actions of Table I: hover, inward and outward spiral search, vertical and horizontal
+sweep."""
 
 from __future__ import annotations
 
 from astralis_des.actions import ACTIONS
 from astralis_des.actions import coverage as cov
 from astralis_des.actions.common import (
-    ActionGen, Context, dwell, failed, footprint_spacing, plane_to_floor, result, room_of,
+    ActionGen,
+    Context,
+    dwell,
+    failed,
+    footprint_spacing,
+    plane_to_floor,
+    result,
+    room_of,
     search_path,
 )
 from astralis_des.kernel.robot import Robot

@@ -6,7 +6,14 @@ import numpy as np
 
 from astralis_des.actions import ACTIONS
 from astralis_des.actions.common import (
-    ActionGen, Context, dwell, failed, result, room_of, route, traverse,
+    ActionGen,
+    Context,
+    dwell,
+    failed,
+    result,
+    room_of,
+    route,
+    traverse,
 )
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task, TaskStatus

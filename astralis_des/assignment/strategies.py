@@ -43,13 +43,15 @@ STRATEGIES: Registry[str, Strategy] = Registry("assignment strategy")
 
 
 @STRATEGIES.register("mixed")
-def mixed(agents: Sequence[Agent], rooms: Sequence[RoomInfo], weights: Weights) -> NDArray[np.float64]:
+def mixed(agents: Sequence[Agent], rooms: Sequence[RoomInfo],
+          weights: Weights) -> NDArray[np.float64]:
     """The paper's mixed heuristic: Eq. 1 with the risk and messiness weights."""
     return eq1_costs(agents, rooms, weights)
 
 
 @STRATEGIES.register("naive")
-def naive(agents: Sequence[Agent], rooms: Sequence[RoomInfo], weights: Weights) -> NDArray[np.float64]:
+def naive(agents: Sequence[Agent], rooms: Sequence[RoomInfo],
+          weights: Weights) -> NDArray[np.float64]:
     """The paper's baseline: Eq. 1's normalised distance alone."""
     return eq1_costs(agents, rooms, Weights.zero())
 

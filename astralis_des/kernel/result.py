@@ -20,6 +20,7 @@ class RobotStats:
     tasks_succeeded: int
     tasks_failed: int
     tasks_cancelled: int
+    tasks_preempted: int
     faulted: bool
 
 
@@ -55,7 +56,8 @@ class RunResult:
         data = asdict(self)
         data.pop("events")
         data.pop("wall_time")
-        return plain(data)  # type: ignore[no-any-return]
+        summary: dict[str, Any] = plain(data)
+        return summary
 
 
 def build_result(sim: Simulation, outcome: str, wall_time: float) -> RunResult:
@@ -65,8 +67,8 @@ def build_result(sim: Simulation, outcome: str, wall_time: float) -> RunResult:
         mine = [res.status.value for task, res in sim.finished if task.robot == rid]
         stats[rid] = RobotStats(
             robot.kind, robot.distance, robot.busy_time, max(now - robot.busy_time, 0.0),
-            mine.count("succeeded"), mine.count("failed") + mine.count("preempted"),
-            mine.count("cancelled"), robot.faulted)
+            mine.count("succeeded"), mine.count("failed"), mine.count("cancelled"),
+            mine.count("preempted"), robot.faulted)
     coverage = {task.room: float(res.coverage) for task, res in sim.finished
                 if task.room and res.coverage is not None and res.ok}
     detection = next((r for r in sim.log.records if r["kind"] == "detection"), None)

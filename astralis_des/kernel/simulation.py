@@ -97,7 +97,7 @@ class Simulation:
         return handler.preempt(task) if preempt else handler.submit(task)
 
     def _run_action(self, robot: Robot, task: Task) -> Generator[simpy.Event, Any, ActionResult]:
-        start = self.env.now
+        start, travelled = self.env.now, robot.distance
         try:
             action = ACTIONS.get((robot.kind, task.action))
             outcome = yield from action(self, robot, task)
@@ -105,7 +105,8 @@ class Simulation:
             cause = stop.cause if isinstance(stop.cause, Stop) else Stop(
                 TaskStatus.CANCELLED, str(stop.cause))
             self.cosim.halt(robot)
-            outcome = ActionResult(cause.status, cause.message)
+            outcome = ActionResult(cause.status, cause.message,
+                                   distance=robot.distance - travelled)
         outcome.start, outcome.end = start, self.env.now
         return outcome
 
@@ -129,8 +130,7 @@ class Simulation:
     # -- assignment ------------------------------------------------------------------------
     def assignment_round(self, segment: str, rooms: list[str], robots: list[Robot]) -> Assignment:
         cfg = self.mission.spec.assignment
-        agents = [Agent(r.id, r.kind, tuple(r.position(self.env.now).tolist()))  # type: ignore[arg-type]
-                  for r in robots]
+        agents = [Agent(r.id, r.kind, _xyz(r.position(self.env.now))) for r in robots]
         infos = [RoomInfo(rid, self.world.rooms[rid].center, self.rooms[rid].risk,
                           self.rooms[rid].messiness) for rid in rooms]
         weights = Weights(cfg.weights.risk.model_dump(), cfg.weights.messiness.model_dump())
@@ -182,7 +182,7 @@ class Simulation:
             if self.found.triggered:
                 outcome = "found"
             elif timeline.triggered:
-                outcome = timeline.value
+                outcome = str(timeline.value)
             else:
                 outcome = "time_limit"
         finally:
@@ -196,3 +196,7 @@ class Simulation:
             sinks.close(result)
         log.info("%s: %s at t=%.1f s", spec.name, outcome, self.env.now)
         return result
+
+
+def _xyz(p: np.ndarray) -> tuple[float, float, float]:
+    return (float(p[0]), float(p[1]), float(p[2]))

@@ -4,13 +4,17 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable, Generator
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import simpy
 
-from astralis_des.kernel.tasks import Stop, TaskStatus
+from astralis_des.kernel.tasks import ActionResult, Stop, TaskStatus
 from astralis_des.mission.spec import (
-    CancelEvent, CommandEvent, FaultEvent, RecoverEvent, RoomChangeEvent,
+    CancelEvent,
+    CommandEvent,
+    FaultEvent,
+    RecoverEvent,
+    RoomChangeEvent,
 )
 from astralis_des.registry import Registry
 
@@ -45,7 +49,8 @@ def search(sim: Simulation) -> Generator[simpy.Event, Any, str]:
                                                   round=len(sim.rounds))
             yield simpy.AllOf(sim.env, list(searches.values()))
             for room, done in searches.items():
-                if done.value.ok:
+                outcome = cast(ActionResult, done.value)
+                if outcome.ok:
                     pending.remove(room)
                     sim.searched.append(room)
                     continue

@@ -101,8 +101,9 @@ def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None
         if robot is not None and robot not in kinds:
             raise doc.error(("timeline", i, "robot"),
                             f"no robot '{robot}' in the team; {suggest(robot, kinds)}")
-        if getattr(event, "room", None) is not None:
-            room(event.room, ("timeline", i, "room"))  # type: ignore[union-attr]
+        event_room = getattr(event, "room", None)
+        if event_room is not None:
+            room(event_room, ("timeline", i, "room"))
         if isinstance(event, CommandEvent):
             try:
                 ACTIONS.get((kinds[event.robot], event.action))

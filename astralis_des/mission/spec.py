@@ -5,7 +5,12 @@ from __future__ import annotations
 from typing import Annotated, Literal
 
 from pydantic import (
-    BaseModel, ConfigDict, Field, NonNegativeFloat, PositiveFloat, model_validator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    NonNegativeFloat,
+    PositiveFloat,
+    model_validator,
 )
 
 Vec3 = tuple[float, float, float]
@@ -55,7 +60,7 @@ class AvatarSpec(Strict):
 class TargetSpec(Strict):
     room: str | None = Field(None, description="room id; drawn from the searched rooms if unset")
     position: Vec3 | None = Field(None, description="drawn inside the room if unset")
-    avatar: AvatarSpec = AvatarSpec()
+    avatar: AvatarSpec = Field(default_factory=AvatarSpec)
 
 
 class KindWeights(Strict):
@@ -65,15 +70,21 @@ class KindWeights(Strict):
 
 
 class WeightsSpec(Strict):
-    """Eq. 1's W1 (on risk) and W2 (on messiness), per agent kind."""
+    """Eq. 1's W1 (on risk) and W2 (on messiness), per agent kind.
+
+    The paper prints W1 = [0, 5, 10] and W2 = [5, 0, 10] in the order [human, UAV, UGV]; read
+    that way, the human is sent to high-risk rooms more often than by the naive baseline. W1
+    read in reverse order (human 10, UAV 5, UGV 0) keeps the human out of them, as the paper
+    reports, and lets the UGV take high-risk rooms, as its text says; that is the default.
+    """
 
     risk: KindWeights = KindWeights(human=10.0, uav=5.0, ugv=0.0)
-    messiness: KindWeights = KindWeights(human=10.0, uav=0.0, ugv=5.0)
+    messiness: KindWeights = KindWeights(human=5.0, uav=0.0, ugv=10.0)
 
 
 class AssignmentSpec(Strict):
     strategy: str = "mixed"
-    weights: WeightsSpec = WeightsSpec()
+    weights: WeightsSpec = Field(default_factory=WeightsSpec)
     high_risk: Unit = 0.5
     high_messiness: Unit = 0.5
     solver: Literal["scipy", "networkx"] = "scipy"
@@ -140,11 +151,11 @@ class MissionSpec(Strict):
     fidelity: Literal["kinematic"] = "kinematic"
     time_limit: PositiveFloat = 3600.0
     team: list[MemberSpec] = Field(min_length=1)
-    rooms: RoomsSpec = RoomsSpec()
-    target: TargetSpec = TargetSpec()
-    assignment: AssignmentSpec = AssignmentSpec()
+    rooms: RoomsSpec = Field(default_factory=RoomsSpec)
+    target: TargetSpec = Field(default_factory=TargetSpec)
+    assignment: AssignmentSpec = Field(default_factory=AssignmentSpec)
     timeline: list[TimelineEvent] = Field(default_factory=list)
-    outputs: OutputsSpec = OutputsSpec()
+    outputs: OutputsSpec = Field(default_factory=OutputsSpec)
 
     @model_validator(mode="after")
     def _unique_ids(self) -> MissionSpec:

@@ -1,4 +1,5 @@
-"""Entity paths of a recording, in one place: ``world/...``, ``robots/<id>/...``, ``mission/...``."""
+"""Entity paths of a recording, in one place: ``world/...``, ``robots/<id>/...``,
+``mission/...``."""
 
 from __future__ import annotations
 

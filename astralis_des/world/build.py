@@ -111,7 +111,8 @@ def _floor_walls(
     t, top = b.wall_thickness, z + b.floor_height - b.wall_thickness
     rw = b.room_size[0]
 
-    def wall(axis: int, at: float, a: float, c: float, gaps: list[float], width: float) -> list[Box]:
+    def wall(axis: int, at: float, a: float, c: float, gaps: list[float],
+             width: float) -> list[Box]:
         """Wall on the line ``coord[axis] == at`` from ``a`` to ``c``, with door gaps."""
         out: list[Box] = []
         start = a

@@ -3,6 +3,7 @@ stairwells, entrances and outdoor corners, solved all-pairs once per world and a
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -66,7 +67,7 @@ class Router:
             rooms = [r for r in w.rooms.values() if r.corridor == corr.id]
             xs = sorted({box.lo[0] + 0.5, box.hi[0] - 0.75, *(r.door.center[0] for r in rooms)})
             nodes = [self._node(f"{corr.id}:{i}", (x, yc, z)) for i, x in enumerate(xs)]
-            for u, v in zip(nodes, nodes[1:], strict=False):
+            for u, v in itertools.pairwise(nodes):
                 self._edge(u, v)
             self.corridor_nodes[corr.id] = nodes
             for room in rooms:

@@ -8,7 +8,8 @@ from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, m
 
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
-KINDS = ("uav", "ugv", "human")
+Kind = Literal["uav", "ugv", "human"]
+KINDS: tuple[Kind, ...] = ("uav", "ugv", "human")
 
 
 class Strict(BaseModel):
@@ -33,8 +34,8 @@ class BuildingSpec(Strict):
     lobby_length: PositiveFloat = 4.0
     door_width: PositiveFloat = 1.0
     door_height: PositiveFloat = 2.1
-    stairs_passable_by: list[Literal["uav", "ugv", "human"]] = Field(
-        default_factory=lambda: ["uav", "ugv", "human"],
+    stairs_passable_by: list[Kind] = Field(
+        default_factory=lambda: list(KINDS),
         description="who can change floors (stairs with a vehicle ramp by default)")
     segments: list[SegmentSpec] = Field(min_length=1)
 

@@ -1,0 +1,162 @@
+"""``astralis``: run, validate and describe missions from the command line.
+
+Heavy modules are imported inside the commands, so ``astralis --help`` answers at once.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from astralis_des.kernel.result import RunResult
+
+EXIT_BAD_INPUT = 2
+EXIT_INTERRUPTED = 130
+Command = Callable[[argparse.Namespace], int]
+COMMANDS: dict[str, Command] = {}
+
+
+def command(name: str) -> Callable[[Command], Command]:
+    def add(fn: Command) -> Command:
+        COMMANDS[name] = fn
+        return fn
+
+    return add
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="astralis", description="Discrete-event missions for UAV/UGV/human search teams.")
+    parser.add_argument("--version", action="store_true", help="print the version and exit")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    run = sub.add_parser("run", help="run a mission file and write its outputs")
+    run.add_argument("mission", help="mission YAML file")
+    run.add_argument("--out", help="output folder (default: the mission's outputs.dir, "
+                     "else out/<mission name>)")
+    run.add_argument("--seed", type=int, help="override the mission's seed")
+    run.add_argument("--no-recording", action="store_true", help="skip the Rerun recording")
+    run.add_argument("--quiet", action="store_true", help="no progress bar or summary table")
+    val = sub.add_parser("validate", help="check a mission file without running it")
+    val.add_argument("mission", help="mission YAML file")
+    schema = sub.add_parser("schema", help="print the JSON Schema of mission or world files")
+    schema.add_argument("--world", action="store_true", help="the world file's schema")
+    schema.add_argument("-o", "--output", help="write to this file instead of stdout")
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    if args.version:
+        from astralis_des import __version__
+
+        print(f"astralis-des {__version__}")
+        return 0
+    if args.command is None:
+        _parser().print_help()
+        return 0
+    from astralis_des.errors import InputError
+
+    try:
+        return COMMANDS[args.command](args)
+    except InputError as exc:
+        print(f"error: {exc.one_line()}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+
+@command("validate")
+def _validate(args: argparse.Namespace) -> int:
+    from astralis_des.mission.loader import load_mission
+
+    mission = load_mission(args.mission)
+    print(f"ok: {args.mission}: mission '{mission.name}', {len(mission.spec.team)} agents, "
+          f"{len(mission.searched_rooms())} rooms to search in world '{mission.world.name}'")
+    return 0
+
+
+@command("schema")
+def _schema(args: argparse.Namespace) -> int:
+    from astralis_des.mission.spec import MissionSpec
+    from astralis_des.world.spec import WorldSpec
+
+    model = WorldSpec if args.world else MissionSpec
+    text = json.dumps(model.model_json_schema(), indent=2) + "\n"
+    if args.output:
+        Path(args.output).write_text(text, encoding="utf-8")
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
+@command("run")
+def _run(args: argparse.Namespace) -> int:
+    from rich.console import Console
+
+    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.mission.loader import load_mission
+
+    mission = load_mission(args.mission)
+    if args.seed is not None:
+        mission = mission.with_changes(seed=args.seed)
+    if args.no_recording:
+        outputs = mission.spec.outputs.model_copy(update={"recording": False})
+        mission = mission.with_changes(outputs=outputs.model_dump())
+    out = Path(args.out or mission.spec.outputs.dir or Path("out") / mission.name)
+    console = Console(stderr=True, quiet=args.quiet)
+    try:
+        result = _with_progress(console, mission.spec.time_limit,
+                                lambda progress: Simulation(mission, out_dir=out,
+                                                            progress=progress).run())
+    except KeyboardInterrupt:
+        console.print(f"[yellow]interrupted[/]; what was recorded is in {out}/")
+        return EXIT_INTERRUPTED
+    if not args.quiet:
+        _print_summary(Console(), result, out)
+    return 0
+
+
+def _with_progress(console: Any, limit: float, run: Callable[[Any], RunResult]) -> RunResult:
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    columns = (TextColumn("[bold]mission"), BarColumn(),
+               TextColumn("sim {task.completed:>7.1f} s of {task.total:.0f} s"),
+               TimeElapsedColumn())
+    with Progress(*columns, console=console, transient=False) as bar:
+        task = bar.add_task("mission", total=limit)
+        last = [0.0]
+
+        def advance(now: float, _limit: float) -> None:
+            if now - last[0] >= limit / 200:
+                last[0] = now
+                bar.update(task, completed=now)
+
+        result = run(advance)
+        bar.update(task, total=result.end_time, completed=result.end_time)
+    return result
+
+
+def _print_summary(console: Any, result: RunResult, out: Path) -> None:
+    from rich.table import Table
+
+    found = (f"found by {result.found_by} at t = {result.time_to_find:.1f} s"
+             if result.found else result.outcome.replace("_", " "))
+    console.print(f"[bold]{result.mission}[/] (seed {result.seed}, {result.fidelity}): {found}; "
+                  f"target in {result.target['room']}; {len(result.rounds)} assignment rounds, "
+                  f"{len(result.rooms_searched)} rooms searched; "
+                  f"{result.end_time:.1f} s simulated in {result.wall_time:.2f} s")
+    table = Table("robot", "kind", "distance (m)", "busy (s)", "idle (s)", "tasks ok",
+                  "failed", "cancelled", "preempted", title="team")
+    for rid, s in result.robots.items():
+        table.add_row(rid, s.kind, f"{s.distance:.1f}", f"{s.busy_time:.1f}",
+                      f"{s.idle_time:.1f}", str(s.tasks_succeeded), str(s.tasks_failed),
+                      str(s.tasks_cancelled), str(s.tasks_preempted))
+    console.print(table)
+    console.print(f"outputs: {out}/")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
