@@ -61,7 +61,8 @@ class GeometricSensor:
         if len(pi) == 0:
             return 0.0
         # A room is an empty convex box: from inside it every cell is in sight.
-        inside = np.array([room.box.contains(p) for p in pts])
+        lo, hi = np.asarray(room.box.lo), np.asarray(room.box.hi)
+        inside = np.all((pts >= lo) & (pts <= hi), axis=1)
         seen = np.zeros(len(cells), dtype=bool)
         seen[ci[inside[pi]]] = True
         outside = ~inside[pi] & ~seen[ci]

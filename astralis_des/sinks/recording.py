@@ -20,8 +20,24 @@ OBSTACLE_COLOR = (60, 140, 60, 255)
 ROBOT_COLORS = {"uav": (30, 144, 255, 255), "ugv": (255, 165, 0, 255), "human": (220, 20, 60, 255)}
 
 
+class _TextColumn:
+    """Text lines of one entity, kept until the run closes and sent as one column."""
+
+    def __init__(self) -> None:
+        self.times: list[float] = []
+        self.texts: list[str] = []
+        self.levels: list[str] = []
+
+    def add(self, t: float, text: str, level: str) -> None:
+        self.times.append(t)
+        self.texts.append(text)
+        self.levels.append(level)
+
+
 class RerunRecorder:
-    """Streams to ``recording.rrd`` as the run goes; poses are sent in columns at the end."""
+    """Writes ``recording.rrd``: the world at once, then events, task states and poses in
+    columns when the run closes (also when it is interrupted), since one ``log`` call costs
+    about as much as simulating a whole task."""
 
     def __init__(self, sim: Simulation, path: Path) -> None:
         import rerun as rr
@@ -31,6 +47,7 @@ class RerunRecorder:
         spec = sim.mission.spec
         self.rec = rr.RecordingStream("astralis_des", recording_id=f"{spec.name}-{spec.seed}")
         self.rec.save(path)
+        self._texts: dict[str, _TextColumn] = {}
         self._log_world()
 
     def _log_world(self) -> None:
@@ -60,21 +77,26 @@ class RerunRecorder:
                                                    half_sizes=(hi - lo) / 2, colors=colors,
                                                    labels=labels, show_labels=False))
 
+    def _text(self, entity: str) -> _TextColumn:
+        return self._texts.setdefault(entity, _TextColumn())
+
     def on_event(self, record: Record) -> None:
-        rr, rec = self.rr, self.rec
-        rec.set_time(paths.TIMELINE, duration=record["t"])
-        kind = record["kind"]
-        robot = record.get("robot")
-        text = describe(record)
-        rec.log(paths.MISSION_EVENTS, rr.TextLog(text, level=LEVELS.get(kind, "DEBUG")))
+        t, kind, robot = record["t"], record["kind"], record.get("robot")
+        self._text(paths.MISSION_EVENTS).add(t, describe(record), LEVELS.get(kind, "DEBUG"))
         if robot and kind in ("task_started", "task_finished"):
             state = record["action"] if kind == "task_started" else f"idle ({record['status']})"
-            rec.log(paths.robot_task(robot), rr.TextLog(f"{state} {record.get('room') or ''}"))
+            self._text(paths.robot_task(robot)).add(t, f"{state} {record.get('room') or ''}",
+                                                    "INFO")
         if kind == "room_change":
+            self.rec.set_time(paths.TIMELINE, duration=t)
             self._log_rooms()
 
     def close(self, result: RunResult) -> None:
         rr, rec = self.rr, self.rec
+        for entity, column in self._texts.items():
+            rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE,
+                                                            duration=column.times)],
+                             columns=rr.TextLog.columns(text=column.texts, level=column.levels))
         for rid, robot in self.sim.robots.items():
             times = np.array(robot.trail_t, dtype=float)
             pts = np.array(robot.trail_p, dtype=float)

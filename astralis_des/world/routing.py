@@ -86,10 +86,7 @@ class Router:
                 node = self._node(f"{b.id}.{floor}.stair", (sx, self._pos[corridor[0]][1], z))
                 self._edge(node, corridor[0])
                 if previous is not None:
-                    rise = b.floor_height
-                    lengths = {k: rise if k == "uav" else math.hypot(rise, STAIR_RUN_FACTOR * rise)
-                               for k in passable}
-                    self._edges.append((previous, node, lengths))
+                    self._stairs(previous, node, stair.hi[1] - 0.5, passable)
                 previous = node
             outside = self._node(f"{b.id}:entrance", b.entrance)
             self._edge(outside, self.corridor_nodes[f"{b.id}.1.corridor"][-1])
@@ -108,6 +105,21 @@ class Router:
             clear = self._outdoor_clear(np.repeat(pts[a:a + 1], len(others), 0), pts[others])
             for b_idx in others[clear]:
                 self._edge(self.outdoor_nodes[a], self.outdoor_nodes[b_idx])
+
+    def _stairs(self, lower: int, upper: int, y_max: float, passable: tuple[str, ...]) -> None:
+        """A UAV rises straight up the shaft; walkers and the UGV take a switchback flight
+        whose mid-landing makes the route as long as the stairs (run = 2 x rise)."""
+        x, y, z0 = self._pos[lower]
+        rise = self._pos[upper][2] - z0
+        if "uav" in passable:
+            self._edge(lower, upper, ("uav",))
+        walkers = tuple(k for k in passable if k != "uav")
+        if walkers:
+            run = STAIR_RUN_FACTOR * rise / 2
+            mid = self._node(f"{self.names[lower]}:flight",
+                             (x, min(y + run, y_max), z0 + rise / 2))
+            self._edge(lower, mid, walkers)
+            self._edge(mid, upper, walkers)
 
     def _outdoor_blockers(self) -> FloatArray:
         boxes = [b.footprint for b in self.world.buildings.values()]

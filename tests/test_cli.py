@@ -1,0 +1,261 @@
+"""``astralis run | validate | schema``: the outputs a good mission writes, and the CLI surface.
+
+Full mission runs are shared through module-scoped fixtures (each takes about half a second).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import re
+import shutil
+import subprocess
+import sys
+from importlib.metadata import version
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import astralis_des
+from astralis_des.cli import main
+
+ROOT = Path(__file__).parents[1]
+MISSION = ROOT / "missions" / "urban_search.yaml"
+WORLD = ROOT / "worlds" / "urban_default.yaml"
+TEAM = ["uav1", "uav2", "ugv1", "op1"]
+
+
+def run_cli(*argv: str) -> tuple[int, str, str]:
+    """``main(argv)`` with stdout and stderr captured (usable in module-scoped fixtures)."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(list(argv))
+    return code, out.getvalue(), err.getvalue()
+
+
+def read_events(folder: Path) -> list[dict[str, Any]]:
+    lines = (folder / "events.jsonl").read_text(encoding="utf-8").splitlines()
+    return [json.loads(line) for line in lines]
+
+
+def read_summary(folder: Path) -> dict[str, Any]:
+    return json.loads((folder / "summary.json").read_text(encoding="utf-8"))
+
+
+@pytest.fixture(scope="module")
+def quiet_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, int, str, str]:
+    """``astralis run missions/urban_search.yaml --out DIR --quiet`` (with the recording)."""
+    out = tmp_path_factory.mktemp("quiet") / "out"
+    code, stdout, stderr = run_cli("run", str(MISSION), "--out", str(out), "--quiet")
+    return out, code, stdout, stderr
+
+
+@pytest.fixture(scope="module")
+def loud_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, int, str, str]:
+    """A run without ``--quiet`` and with ``--no-recording``."""
+    out = tmp_path_factory.mktemp("loud") / "out"
+    code, stdout, stderr = run_cli("run", str(MISSION), "--out", str(out), "--no-recording")
+    return out, code, stdout, stderr
+
+
+def test_quiet_run_succeeds_silently(quiet_run: tuple[Path, int, str, str]) -> None:
+    out, code, stdout, stderr = quiet_run
+    assert code == 0, stderr
+    assert stdout == ""
+    assert stderr == ""
+    assert sorted(p.name for p in out.iterdir()) == ["events.jsonl", "recording.rrd",
+                                                      "summary.json"]
+
+
+def test_events_jsonl(quiet_run: tuple[Path, int, str, str]) -> None:
+    out = quiet_run[0]
+    events = read_events(out)
+    assert len(events) >= 2
+    for event in events:
+        assert isinstance(event, dict)
+        assert {"t", "kind"} <= event.keys()
+        assert isinstance(event["t"], int | float)
+        assert isinstance(event["kind"], str)
+    assert events[0]["kind"] == "mission_start"
+    assert events[-1]["kind"] == "mission_end"
+    assert [e["kind"] for e in events].count("mission_start") == 1
+    assert [e["kind"] for e in events].count("mission_end") == 1
+    times = [e["t"] for e in events]
+    assert times == sorted(times), "events are written in simulated-time order"
+    assert events[0]["t"] == 0
+    assert events[0]["seed"] == 42
+    assert events[0]["team"] == TEAM
+
+
+def test_summary_json(quiet_run: tuple[Path, int, str, str]) -> None:
+    out = quiet_run[0]
+    summary = read_summary(out)
+    assert {"outcome", "time_to_find", "robots", "rounds"} <= summary.keys()
+    assert isinstance(summary["outcome"], str) and summary["outcome"]
+    assert summary["seed"] == 42
+    assert summary["mission"] == "urban_search"
+    assert list(summary["robots"]) == TEAM
+    for rid, robot in summary["robots"].items():
+        for key in ("distance", "busy_time", "idle_time"):
+            assert isinstance(robot[key], int | float), (rid, key)
+            assert robot[key] >= 0, (rid, key)
+    assert summary["rounds"], "the mission makes at least one assignment round"
+    for round_ in summary["rounds"]:
+        assert "costs" in round_ and "matching" in round_
+        assert isinstance(round_["costs"], list)
+        assert isinstance(round_["matching"], list)
+    if summary["outcome"] == "found":
+        assert isinstance(summary["time_to_find"], int | float)
+        assert summary["time_to_find"] > 0
+
+
+def test_summary_agrees_with_events(quiet_run: tuple[Path, int, str, str]) -> None:
+    out = quiet_run[0]
+    events, summary = read_events(out), read_summary(out)
+    assert events[-1]["outcome"] == summary["outcome"]
+    assert summary["end_time"] == pytest.approx(events[-1]["t"])
+
+
+def test_recording_rrd(quiet_run: tuple[Path, int, str, str]) -> None:
+    rrd = quiet_run[0] / "recording.rrd"
+    assert rrd.is_file()
+    assert rrd.stat().st_size > 0
+
+
+@pytest.mark.skipif(shutil.which("rerun") is None, reason="no rerun executable on PATH")
+def test_recording_rrd_verifies(quiet_run: tuple[Path, int, str, str]) -> None:
+    rrd = quiet_run[0] / "recording.rrd"
+    rerun = shutil.which("rerun")
+    assert rerun is not None
+    proc = subprocess.run([rerun, "rrd", "verify", str(rrd)], capture_output=True, text=True,
+                          timeout=60)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_no_recording_writes_no_rrd(loud_run: tuple[Path, int, str, str]) -> None:
+    out, code, _, stderr = loud_run
+    assert code == 0, stderr
+    assert (out / "events.jsonl").is_file()
+    assert (out / "summary.json").is_file()
+    assert not list(out.rglob("*.rrd"))
+
+
+def test_summary_output_names_outcome_and_every_robot(
+        loud_run: tuple[Path, int, str, str]) -> None:
+    out, code, stdout, _ = loud_run
+    assert code == 0
+    summary = read_summary(out)
+    outcome = summary["outcome"]
+    assert (outcome.replace("_", " ") in stdout
+            or (outcome == "found" and f"found by {summary['found_by']}" in stdout)), stdout
+    for rid in TEAM:
+        assert re.search(rf"\b{re.escape(rid)}\b", stdout), (rid, stdout)
+    assert str(out) in stdout
+
+
+def test_seed_override_is_recorded(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    code, _, stderr = run_cli("run", str(MISSION), "--out", str(out), "--quiet", "--seed", "5",
+                              "--no-recording")
+    assert code == 0, stderr
+    assert read_summary(out)["seed"] == 5
+    assert read_events(out)[0]["seed"] == 5
+
+
+def test_default_output_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Without --out (and no outputs.dir) the outputs go to out/<mission name> under the cwd."""
+    monkeypatch.chdir(tmp_path)
+    code, _, stderr = run_cli("run", str(MISSION), "--quiet", "--no-recording")
+    assert code == 0, stderr
+    assert (tmp_path / "out" / "urban_search" / "summary.json").is_file()
+
+
+@pytest.mark.xfail(reason="BUG: the non-quiet summary table truncates long robot ids "
+                          "('quadrotor_alpha_one' -> 'quadro…') at the default 80 columns",
+                   strict=True)
+def test_summary_output_shows_long_robot_ids(tmp_path: Path,
+                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("COLUMNS", "80")
+    long_ids = {"uav1": "quadrotor_alpha_one", "op1": "search_and_rescue_operator"}
+    text = MISSION.read_text(encoding="utf-8")
+    text = re.sub(r"(?m)^world:.*$", f"world: {json.dumps(str(WORLD))}", text)
+    for old, new in long_ids.items():
+        text = text.replace(f"id: {old},", f"id: {new},")
+    mission = tmp_path / "mission.yaml"
+    mission.write_text(text, encoding="utf-8")
+    code, stdout, stderr = run_cli("run", str(mission), "--out", str(tmp_path / "out"),
+                                   "--no-recording")
+    assert code == 0, stderr
+    for rid in long_ids.values():
+        assert rid in stdout.split("team")[-1], stdout
+
+
+def test_schema_mission(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["schema"]) == 0
+    schema = json.loads(capsys.readouterr().out)
+    assert "properties" in schema
+    assert "team" in schema["properties"]
+    assert "world" in schema["properties"]
+
+
+def test_schema_world(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["schema", "--world"]) == 0
+    schema = json.loads(capsys.readouterr().out)
+    assert "buildings" in schema["properties"]
+    assert "team" not in schema["properties"]
+
+
+def test_schema_to_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    target = tmp_path / "mission.schema.json"
+    assert main(["schema", "-o", str(target)]) == 0
+    assert capsys.readouterr().out == ""
+    assert "team" in json.loads(target.read_text(encoding="utf-8"))["properties"]
+
+
+def test_help_lists_commands(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["--help"])
+    assert exc.value.code == 0
+    text = capsys.readouterr().out
+    for name in ("run", "validate", "schema"):
+        assert re.search(rf"\b{name}\b", text), name
+
+
+def test_run_help_lists_options(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["run", "--help"])
+    assert exc.value.code == 0
+    text = capsys.readouterr().out
+    for option in ("--out", "--seed", "--no-recording", "--quiet"):
+        assert option in text
+
+
+def test_no_command_prints_help(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([]) == 0
+    assert "validate" in capsys.readouterr().out
+
+
+def test_version(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["--version"]) == 0
+    text = capsys.readouterr().out.strip()
+    assert text == f"astralis-des {astralis_des.__version__}"
+    assert astralis_des.__version__ == version("astralis-des")
+
+
+def test_unknown_command_is_a_usage_error(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["fly"])
+    assert exc.value.code == 2
+    assert "invalid choice" in capsys.readouterr().err
+
+
+def test_console_script_is_installed() -> None:
+    script = shutil.which("astralis") or shutil.which("astralis", path=str(Path(sys.executable)
+                                                                            .parent))
+    if script is None:
+        pytest.skip("the astralis console script is not on PATH")
+    proc = subprocess.run([script, "--help"], capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert "validate" in proc.stdout

@@ -1,0 +1,86 @@
+"""The default urban world: buildings, floors, segments, rooms, and routes through them."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from astralis_des.errors import InputError
+from astralis_des.world.model import World
+
+
+def test_site_is_about_38000_square_metres(world: World) -> None:
+    """The outdoor site matches the paper's estimate of 38,000 m^2 within 5%."""
+    assert world.area == pytest.approx(38_000, rel=0.05)
+    assert set(world.buildings) == {"A", "B"}
+
+
+def test_building_a_has_3_storeys_6_segments_of_3_rooms(world: World) -> None:
+    """Building A: 3 storeys, 6 segments, 18 rooms with ids building.floor.segment.room."""
+    segments = [s for s in world.segments.values() if s.building == "A"]
+    assert world.buildings["A"].floors == 3
+    assert len(segments) == 6
+    assert all(len(s.rooms) == 3 for s in segments)
+    rooms = sorted(r for r in world.rooms if r.startswith("A."))
+    expected = sorted(f"A.{f}.{s}.{r}" for f in (1, 2, 3) for s in (1, 2) for r in (1, 2, 3))
+    assert rooms == expected
+    assert world.segment_order("A") == ["A.1.1", "A.1.2", "A.2.1", "A.2.2", "A.3.1", "A.3.2"]
+
+
+def test_rooms_are_about_7_by_4_metres(world: World) -> None:
+    """Every room's clear interior is 4 m x 7 m less the walls, on its floor's level."""
+    for room in world.rooms.values():
+        sx, sy, _ = room.box.size
+        assert sorted((sx, sy)) == pytest.approx([3.8, 6.8])
+        assert room.box.lo[2] == pytest.approx((room.floor - 1) * 3.5)
+
+
+def test_building_b_is_smaller(world: World) -> None:
+    """Building B has fewer rooms and floors than A."""
+    b_rooms = [r for r in world.rooms if r.startswith("B.")]
+    assert len(b_rooms) == 6
+    assert world.buildings["B"].floors < world.buildings["A"].floors
+
+
+def test_walls_block_sight_and_doors_let_it_through(world: World) -> None:
+    """A line from a room's centre to its neighbour's is blocked; through the door it is not."""
+    a, b = world.rooms["A.1.1.1"], world.rooms["A.1.1.2"]
+    eye = np.array([a.center]) + [0, 0, 1.0]
+    assert not world.line_of_sight(eye, np.array([b.center]) + [0, 0, 1.0])[0]
+    corridor = np.array([a.door_point("corridor", 1.0)]) + [0, 0, 1.0]
+    assert world.line_of_sight(eye, corridor)[0]
+
+
+@pytest.mark.parametrize("kind", ["uav", "ugv", "human"])
+def test_routes_never_cross_a_wall(world: World, kind: str) -> None:
+    """Every leg of every route between rooms, and from outdoors, has a clear line of sight."""
+    starts = [(20.0, 20.0, 0.0), world.rooms["A.1.1.1"].center, world.rooms["B.1.1.2"].center]
+    goals = [world.rooms[r].center for r in ("A.1.2.3", "A.2.1.1", "A.3.2.2", "B.2.1.3")]
+    for start, goal in itertools.product(starts, goals):
+        route = world.router.route(start, goal, kind)
+        assert route is not None
+        legs = route + [0.0, 0.0, 1.0]  # at sensor height, above the floor slabs
+        assert world.line_of_sight(legs[:-1], legs[1:]).all(), (start, goal)
+        assert np.allclose(route[0], start) and np.allclose(route[-1], goal)
+
+
+def test_routes_upstairs_climb_the_stairwell(world: World) -> None:
+    """Walking to the third floor climbs two flights of stairs; a UAV rises straight up."""
+    goal = world.rooms["A.3.1.2"].center
+    walk = world.router.route((20.0, 20.0, 0.0), goal, "human")
+    fly = world.router.route((20.0, 20.0, 0.0), goal, "uav")
+    assert walk is not None and fly is not None
+    assert {0.0, 3.5, 7.0} <= set(np.round(walk[:, 2], 3))
+    length = lambda p: float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())  # noqa: E731
+    # Two flights of stairs, each with a run of twice its 3.5 m rise, against two straight climbs.
+    assert length(walk) - length(fly) == pytest.approx(2 * (np.hypot(3.5, 7.0) - 3.5))
+
+
+def test_points_inside_walls_or_outside_the_site_are_refused(world: World) -> None:
+    """A start inside a building's wall or off the site is an InputError, not a wrong route."""
+    with pytest.raises(InputError, match="outside the world"):
+        world.router.place_of((-5.0, 10.0, 0.0))
+    with pytest.raises(InputError, match="inside a building or obstacle"):
+        world.router.place_of((60.0, 72.0, 1.0))

@@ -1,0 +1,110 @@
+"""Kinematic fidelity benchmark: real-time factor, missions per second, CLI start-up.
+
+    python tools/bench/bench_kinematic.py [--missions 1000] [--repeat 5]
+
+Prints absolute times and, measured in the same run, the ratio of a mission's wall time to a
+bare SimPy replay of the very same task schedule (FIFO stores and timeouts, no planning, no
+sensing): the price of routing, coverage and detection over the raw event kernel.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections import Counter
+from pathlib import Path
+
+import simpy
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+
+from astralis_des import Simulation, load_mission  # noqa: E402
+from astralis_des.kernel.result import RunResult  # noqa: E402
+
+
+def timed(fn):  # type: ignore[no-untyped-def]
+    t0 = time.perf_counter()
+    value = fn()
+    return time.perf_counter() - t0, value
+
+
+def bare_simpy_replay(result: RunResult) -> float:
+    """Wall time of SimPy alone replaying the run's tasks: one FIFO store per robot."""
+    durations: dict[str, list[float]] = {}
+    started: dict[int, float] = {}
+    for rec in result.events:
+        if rec["kind"] == "task_started":
+            started[rec["task"]] = rec["t"]
+        elif rec["kind"] == "task_finished" and rec["task"] in started:
+            durations.setdefault(rec["robot"], []).append(rec["t"] - started[rec["task"]])
+
+    def worker(env, store):  # type: ignore[no-untyped-def]
+        while True:
+            d = yield store.get()
+            yield env.timeout(d)
+
+    t0 = time.perf_counter()
+    env = simpy.Environment()
+    for tasks in durations.values():
+        store = simpy.Store(env)
+        env.process(worker(env, store))
+        for d in tasks:
+            store.put(d)
+    env.run(until=result.end_time)
+    return time.perf_counter() - t0
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--missions", type=int, default=1000)
+    parser.add_argument("--repeat", type=int, default=5)
+    args = parser.parse_args()
+    mission_file = ROOT / "missions" / "urban_search.yaml"
+
+    helps = [timed(lambda: subprocess.run(["astralis", "--help"], capture_output=True,
+                                          check=True))[0] for _ in range(5)]
+    print(f"astralis --help:                      median {statistics.median(helps):.3f} s "
+          f"(goal < 0.5 s)")
+
+    load_s, mission = timed(lambda: load_mission(mission_file))
+    print(f"load mission, world, routing graph:   {load_s:.3f} s (once per world, cached)")
+
+    with tempfile.TemporaryDirectory() as tmp:
+        rec_on = []
+        for i in range(args.repeat):
+            wall, result = timed(lambda i=i: Simulation(mission, out_dir=Path(tmp) / str(i)).run())
+            rec_on.append(wall)
+        size = (Path(tmp) / "0" / "recording.rrd").stat().st_size
+    rec_off = [timed(lambda: Simulation(mission).run())[0] for _ in range(args.repeat)]
+    on, off = statistics.median(rec_on), statistics.median(rec_off)
+    bare = statistics.median(bare_simpy_replay(result) for _ in range(args.repeat))
+    print(f"default mission ({result.end_time:.1f} s simulated, outcome {result.outcome}):")
+    print(f"  outputs + recording on:             {on * 1e3:8.1f} ms  real-time factor "
+          f"{result.end_time / on:8.0f}x (goal >= 2,000x); recording {size / 1024:.0f} KiB")
+    print(f"  no outputs:                         {off * 1e3:8.1f} ms  real-time factor "
+          f"{result.end_time / off:8.0f}x")
+    print(f"  outputs' share of the run:          {(on - off) / on:8.1%}")
+    print(f"  bare SimPy replay of its tasks:     {bare * 1e3:8.2f} ms  -> ours / bare = "
+          f"{off / bare:.0f}x")
+
+    seeds = range(args.missions)
+    t0 = time.perf_counter()
+    outcomes: Counter[str] = Counter()
+    sim_total = 0.0
+    for seed in seeds:
+        r = Simulation(mission.with_changes(seed=seed)).run()
+        outcomes[r.outcome] += 1
+        sim_total += r.end_time
+    total = time.perf_counter() - t0
+    print(f"{args.missions} kinematic missions, recording off (seeds 0..{args.missions - 1}):")
+    print(f"  total {total:.1f} s (goal < 60 s), {args.missions / total:.0f} missions/s, "
+          f"mean real-time factor {sim_total / total:.0f}x; outcomes {dict(outcomes)}")
+
+
+if __name__ == "__main__":
+    main()
