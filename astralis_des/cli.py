@@ -96,6 +96,7 @@ def _schema(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     from rich.console import Console
 
+    from astralis_des.errors import InputError
     from astralis_des.kernel.simulation import Simulation
     from astralis_des.mission.loader import load_mission
 
@@ -106,6 +107,8 @@ def _run(args: argparse.Namespace) -> int:
         outputs = mission.spec.outputs.model_copy(update={"recording": False})
         mission = mission.with_changes(outputs=outputs.model_dump())
     out = Path(args.out or mission.spec.outputs.dir or Path("out") / mission.name)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"{out} exists and is not a folder", key="--out")
     console = Console(stderr=True, quiet=args.quiet)
     try:
         result = _with_progress(console, mission.spec.time_limit,
@@ -148,8 +151,11 @@ def _print_summary(console: Any, result: RunResult, out: Path) -> None:
                   f"target in {result.target['room']}; {len(result.rounds)} assignment rounds, "
                   f"{len(result.rooms_searched)} rooms searched; "
                   f"{result.end_time:.1f} s simulated in {result.wall_time:.2f} s")
-    table = Table("robot", "kind", "distance (m)", "busy (s)", "idle (s)", "tasks ok",
-                  "failed", "cancelled", "preempted", title="team")
+    table = Table(title="team")
+    table.add_column("robot", no_wrap=True)
+    for header in ("kind", "distance (m)", "busy (s)", "idle (s)", "tasks ok", "failed",
+                   "cancelled", "preempted"):
+        table.add_column(header, justify="right" if header != "kind" else "left")
     for rid, s in result.robots.items():
         table.add_row(rid, s.kind, f"{s.distance:.1f}", f"{s.busy_time:.1f}",
                       f"{s.idle_time:.1f}", str(s.tasks_succeeded), str(s.tasks_failed),

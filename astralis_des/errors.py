@@ -24,10 +24,10 @@ class InputError(Exception):
         super().__init__(self.one_line())
 
     def one_line(self) -> str:
-        place = self.file or "<input>"
+        place = self.file or ""
         if self.line is not None:
             place += f":{self.line}"
-        text = f"{place}: "
+        text = f"{place}: " if place else ""
         if self.key:
             text += f"{self.key}: "
         return text + " ".join(self.message.split())

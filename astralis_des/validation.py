@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import types
 import typing
 from typing import Any, TypeVar
@@ -31,6 +32,12 @@ def _to_input_error(model: type[BaseModel], doc: LocatedYaml, exc: ValidationErr
         owner = _model_at(model, path[:-1])
         fields = list(owner.model_fields) if owner is not None else []
         return doc.error(path, f"unknown key '{key}'; {suggest(key, fields)}")
+    if error["type"] == "union_tag_invalid":
+        ctx = error.get("ctx", {})
+        key = str(ctx.get("discriminator", "type")).strip("'\"")
+        expected = re.findall(r"'([^']*)'", str(ctx.get("expected_tags", "")))
+        tag = str(ctx.get("tag", ""))
+        return doc.error((*path, key), f"unknown {key} '{tag}'; {suggest(tag, expected)}")
     if error["type"] == "missing":
         return doc.error(path, "this key is required")
     message = str(error["msg"])
@@ -57,14 +64,23 @@ def _drop_union_tags(model: type[BaseModel], path: KeyPath) -> KeyPath:
     current: Any = model
     for part in path:
         candidates = _models_in(current)
-        if isinstance(part, str) and candidates and not any(
-            part in c.model_fields for c in candidates
-        ) and any(c.__name__ == part or part.startswith(c.__name__) for c in candidates):
-            current = next(c for c in candidates if part.startswith(c.__name__))
-            continue
+        if isinstance(part, str) and len(candidates) > 1 and not any(
+                part in c.model_fields for c in candidates):
+            chosen = next((c for c in candidates if _is_tag(c, part)), None)
+            if chosen is not None:
+                current = chosen
+                continue
         kept.append(part)
         current = _step(current, part)
     return tuple(kept)
+
+
+def _is_tag(model: type[BaseModel], part: str) -> bool:
+    """Is ``part`` the name pydantic gives this union member: its class or its tag value?"""
+    if part.startswith(model.__name__):
+        return True
+    return any(typing.get_origin(f.annotation) is typing.Literal
+               and part in typing.get_args(f.annotation) for f in model.model_fields.values())
 
 
 def _models_in(annotation: Any) -> list[type[BaseModel]]:

@@ -44,39 +44,97 @@ def format_path(path: KeyPath) -> str:
     return text
 
 
-def _construct(node: yaml.Node, path: KeyPath, lines: dict[KeyPath, int], file: Path) -> Any:
-    if isinstance(node, yaml.MappingNode):
+MAX_VALUES = 200_000  # a file that expands to more values than this is refused
+_PLAIN_TAGS = {"tag:yaml.org,2002:map", "tag:yaml.org,2002:seq", "tag:yaml.org,2002:omap"}
+
+
+class _Builder:
+    """Turns a composed node graph into plain data, recording the line of every key path.
+
+    Aliases are followed, with a budget on the values they expand to and a refusal of
+    recursive ones; tags other than YAML's own are refused, as are non-scalar keys.
+    """
+
+    def __init__(self, file: Path) -> None:
+        self.file = file
+        self.lines: dict[KeyPath, int] = {}
+        self.expanded = 0  # values the data holds once every alias is followed
+        self._stack: set[int] = set()
+        self._shared: dict[int, tuple[Any, int]] = {}  # aliased node -> its value and size
+
+    def _fail(self, node: yaml.Node, message: str, path: KeyPath) -> InputError:
+        return InputError(message, file=self.file, line=node.start_mark.line + 1,
+                          key=format_path(path) or None)
+
+    def build(self, node: yaml.Node, path: KeyPath) -> Any:
+        if id(node) in self._shared:  # an alias: the value built at its anchor, shared
+            value, size = self._shared[id(node)]
+            self._grow(node, size, path)
+            return value
+        before = self.expanded
+        self._grow(node, 1, path)
+        if isinstance(node, yaml.ScalarNode):
+            return _scalar(node, self, path)
+        if node.tag not in _PLAIN_TAGS:
+            raise self._fail(node, f"tag '{node.tag}' is not allowed", path)
+        if id(node) in self._stack:
+            raise self._fail(node, "a recursive alias refers to itself", path)
+        self._stack.add(id(node))
+        try:
+            if isinstance(node, yaml.SequenceNode):
+                value = []
+                for index, item in enumerate(node.value):
+                    self.lines[(*path, index)] = item.start_mark.line + 1
+                    value.append(self.build(item, (*path, index)))
+            else:
+                value = self._mapping(node, path)
+        finally:
+            self._stack.discard(id(node))
+        self._shared[id(node)] = (value, self.expanded - before)
+        return value
+
+    def _grow(self, node: yaml.Node, size: int, path: KeyPath) -> None:
+        self.expanded += size
+        if self.expanded > MAX_VALUES:
+            raise self._fail(node, f"the file expands to more than {MAX_VALUES:,} values "
+                             "(aliases nested too deep?)", path)
+
+    def _mapping(self, node: yaml.Node, path: KeyPath) -> dict[str, Any]:
         result: dict[str, Any] = {}
+        merged: dict[str, Any] = {}
         for key_node, value_node in node.value:
-            key = _construct(key_node, path, {}, file)
-            if not isinstance(key, str | int | float | bool):
-                raise InputError("a mapping key must be a plain value", file=file,
-                                 line=key_node.start_mark.line + 1, key=format_path(path))
-            key = str(key)
+            if not isinstance(key_node, yaml.ScalarNode):
+                raise self._fail(key_node, "a mapping key must be a plain value", path)
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                sources = value_node.value if isinstance(value_node, yaml.SequenceNode) \
+                    else [value_node]
+                for source in sources:
+                    value = self.build(source, path)
+                    if not isinstance(value, dict):
+                        raise self._fail(value_node, "'<<' merges mappings only", path)
+                    merged.update({k: v for k, v in value.items() if k not in merged})
+                continue
+            key = str(_scalar(key_node, self, path))
             child = (*path, key)
             if key in result:
-                raise InputError(f"duplicate key '{key}' (first at line {lines[child]})",
-                                 file=file, line=key_node.start_mark.line + 1,
+                raise InputError(f"duplicate key '{key}' (first at line {self.lines[child]})",
+                                 file=self.file, line=key_node.start_mark.line + 1,
                                  key=format_path(child))
-            lines[child] = key_node.start_mark.line + 1
-            result[key] = _construct(value_node, child, lines, file)
+            self.lines[child] = key_node.start_mark.line + 1
+            result[key] = self.build(value_node, child)
+        for key, value in merged.items():
+            result.setdefault(key, value)
         return result
-    if isinstance(node, yaml.SequenceNode):
-        items = []
-        for index, item in enumerate(node.value):
-            child = (*path, index)
-            lines[child] = item.start_mark.line + 1
-            items.append(_construct(item, child, lines, file))
-        return items
-    assert isinstance(node, yaml.ScalarNode)
-    return _scalar(node)
 
 
 _SCALAR_LOADER = yaml.SafeLoader("")
 
 
-def _scalar(node: yaml.ScalarNode) -> Any:
-    return _SCALAR_LOADER.construct_object(node, deep=True)
+def _scalar(node: yaml.ScalarNode, builder: _Builder, path: KeyPath) -> Any:
+    try:
+        return _SCALAR_LOADER.construct_object(node, deep=True)
+    except yaml.constructor.ConstructorError as exc:
+        raise builder._fail(node, f"YAML error: {exc.problem}", path) from None
 
 
 def load_yaml(file: str | Path) -> LocatedYaml:
@@ -91,19 +149,20 @@ def load_yaml(file: str | Path) -> LocatedYaml:
     try:
         root = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
+        # An unclosed bracket or quote shows up lines later, often at the end of the file;
+        # the line where it was opened (the context) is the one to fix.
+        opened = bool(exc.context) and any(w in str(exc.context) for w in ("flow", "quoted"))
+        mark = exc.context_mark if opened and exc.context_mark else exc.problem_mark
         line = mark.line + 1 if mark is not None else None
-        raise InputError(f"YAML syntax error: {exc.problem or exc}", file=path,
-                         line=line) from None
+        what = exc.problem or str(exc)
+        if opened:
+            what += f" ({exc.context} that starts here)"
+        raise InputError(f"YAML syntax error: {what}", file=path, line=line) from None
     except yaml.YAMLError as exc:
         raise InputError(f"YAML error: {exc}", file=path) from None
     if root is None:
         raise InputError("the file is empty", file=path)
-    lines: dict[KeyPath, int] = {(): root.start_mark.line + 1}
-    try:
-        data = _construct(root, (), lines, path)
-    except yaml.constructor.ConstructorError as exc:
-        mark = exc.problem_mark
-        raise InputError(f"YAML error: {exc.problem}", file=path,
-                         line=mark.line + 1 if mark else None) from None
-    return LocatedYaml(data, lines, path)
+    builder = _Builder(path)
+    builder.lines[()] = root.start_mark.line + 1
+    data = builder.build(root, ())
+    return LocatedYaml(data, builder.lines, path)

@@ -172,9 +172,6 @@ def test_default_output_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) 
     assert (tmp_path / "out" / "urban_search" / "summary.json").is_file()
 
 
-@pytest.mark.xfail(reason="BUG: the non-quiet summary table truncates long robot ids "
-                          "('quadrotor_alpha_one' -> 'quadro…') at the default 80 columns",
-                   strict=True)
 def test_summary_output_shows_long_robot_ids(tmp_path: Path,
                                              monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("COLUMNS", "80")

@@ -238,9 +238,6 @@ def test_interrupt_at_the_instant_the_task_starts(how: str) -> None:
         assert span(pre[0]) == ("succeeded", 0, 1)
 
 
-@pytest.mark.xfail(reason="BUG: a task taken from the queue but not yet started is neither "
-                          "queued nor current, so cancel(id) misses it and it runs anyway",
-                   strict=True)
 def test_cancel_next_task_when_previous_finishes() -> None:
     """Cancelling the next task at the instant the previous one finishes cancels it."""
     b = Bench()
@@ -259,8 +256,6 @@ def test_cancel_next_task_when_previous_finishes() -> None:
     assert span(second) == ("cancelled", 5, 5)
 
 
-@pytest.mark.xfail(reason="BUG: cancel() at t=0 right after submit misses the task the worker "
-                          "has already taken from the queue", strict=True)
 def test_cancel_all_at_time_zero() -> None:
     """``cancel()`` called at t=0 by a process started after ``submit`` cancels the task."""
     b = Bench()

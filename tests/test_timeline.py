@@ -15,7 +15,7 @@ from typing import Any
 
 import pytest
 
-from astralis_des import Mission, RunResult, Simulation, load_mission
+from astralis_des import InputError, Mission, RunResult, Simulation, load_mission
 from astralis_des.assignment import table4_action
 
 MISSION = Path(__file__).resolve().parents[1] / "missions" / "urban_search.yaml"
@@ -103,9 +103,6 @@ def test_recover_brings_the_robot_back(mission: Mission) -> None:
     assert result.robots["uav1"].faulted is False
 
 
-@pytest.mark.xfail(reason="BUG: at t=0 the robot's first task has been taken from its queue but "
-                          "not started; fault/cancel/preempt at t=0 miss it and it runs on",
-                   strict=True)
 @pytest.mark.parametrize(("event", "status"), [
     ({"event": "fault"}, "failed"),
     ({"event": "cancel"}, "cancelled"),
@@ -267,3 +264,28 @@ def test_time_limit(mission: Mission) -> None:
     assert result.events[-1] == {"t": 30.0, "kind": "mission_end", "outcome": "time_limit"}
     assert max(e["t"] for e in result.events) == 30.0
     assert all(r["t"] <= 30 for r in result.rounds)
+
+
+# -- with_changes ---------------------------------------------------------------------------
+def test_with_changes_validates_the_schema(mission: Mission) -> None:
+    """``with_changes`` re-validates: a malformed timeline event is refused."""
+    with pytest.raises(InputError, match=r"timeline\[0\]\.risk: .*less than or equal to 1"):
+        mission.with_changes(timeline=[{"at": 1, "event": "room_change", "room": "A.1.1.1",
+                                        "risk": 2.0}])
+
+
+def test_with_changes_leaves_the_original(mission: Mission) -> None:
+    """``with_changes`` returns a copy; the original mission is unchanged."""
+    changed = mission.with_changes(seed=3, timeline=[{"at": 10, "event": "fault",
+                                                      "robot": "uav1"}])
+    assert (changed.spec.seed, len(changed.spec.timeline)) == (3, 1)
+    assert (mission.spec.seed, mission.spec.timeline) == (42, [])
+    assert changed.world is mission.world
+
+
+def test_with_changes_refuses_an_unknown_robot(mission: Mission) -> None:
+    """A timeline event naming a robot not in the team is an InputError before the run."""
+    with pytest.raises(InputError, match="nobody"):
+        changed = mission.with_changes(timeline=[{"at": 10, "event": "fault",
+                                                  "robot": "nobody"}])
+        Simulation(changed)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import textwrap
 import tracemalloc
 from pathlib import Path
@@ -135,16 +136,11 @@ def test_python_object_tag_never_runs_code(tmp_path: Path) -> None:
     path = write(tmp_path,
                  f"a: !!python/object/apply:os.system ['touch {marker}']\n"
                  f"b: !!python/object/new:pathlib.Path ['{marker}']\n")
-    try:
+    with contextlib.suppress(InputError):
         load_yaml(path)
-    except InputError:
-        pass
     assert not marker.exists()
 
 
-@pytest.mark.xfail(reason="BUG: !!python/object tags on a mapping or sequence are silently "
-                          "dropped (the node is read as a plain dict/list), not refused",
-                   strict=True)
 @pytest.mark.parametrize("text", [
     "a: !!python/object:collections.OrderedDict {x: 1}\n",
     "a: !!python/object/apply:os.system [echo hi]\n",
@@ -208,18 +204,12 @@ def test_aliases_are_expanded(tmp_path: Path) -> None:
     assert doc.data == {"base": {"speed": 2}, "other": {"speed": 2}}
 
 
-@pytest.mark.xfail(reason="BUG: a recursive alias makes load_yaml recurse until "
-                          "RecursionError instead of raising InputError", strict=True)
 def test_recursive_alias_is_an_input_error(tmp_path: Path) -> None:
     with pytest.raises(InputError) as exc:
         load_yaml(write(tmp_path, "a: 1\nb: &x [1, *x]\n"))
     assert exc.value.line == 2
 
 
-@pytest.mark.xfail(reason="BUG: aliases are re-expanded per use (and a line stored per path), "
-                          "so a few lines of nested aliases ('billion laughs') take "
-                          "exponential time and memory; yaml.safe_load shares them",
-                   strict=True)
 def test_alias_bomb_is_cheap_or_refused(tmp_path: Path) -> None:
     # 10**4 leaves here; every extra line multiplies the cost of load_yaml by ten.
     lines = ["l0: &l0 [x, x, x, x, x, x, x, x, x, x]"]

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Generator
-from typing import Any
+from typing import Any, cast
 
 import simpy
 
@@ -28,12 +28,20 @@ class TaskHandler:
         self._active: simpy.Process | None = None
         self._done: dict[int, simpy.Event] = {}
         self._on_change = on_change
+        self._get: simpy.Event | None = None
+        self._dropped: set[int] = set()
         self.worker = env.process(self._work())
+
+    def _taken(self) -> Task | None:
+        """The task the worker has taken from the queue but not yet started (same instant)."""
+        get = self._get
+        return cast(Task, get.value) if get is not None and get.triggered else None
 
     @property
     def queued(self) -> list[Task]:
         """Tasks waiting, in the order they will run."""
-        return list(self.queue.items)
+        taken = self._taken()
+        return ([taken] if taken is not None else []) + list(self.queue.items)
 
     def submit(self, task: Task, *, front: bool = False) -> simpy.Event:
         done = self.env.event()
@@ -49,18 +57,28 @@ class TaskHandler:
 
     def cancel(self, task_id: int | None = None, reason: str = "cancelled") -> list[Task]:
         """Cancel one task (queued or running) or, with no id, all of them."""
-        hit = [t for t in self.queue.items if task_id in (None, t.id)]
+        hit = [t for t in self.queued if task_id in (None, t.id)]
         for task in hit:
-            self.queue.items.remove(task)
-            self._settle(task, ActionResult(TaskStatus.CANCELLED, reason, self.env.now,
-                                            self.env.now))
+            self._drop(task, TaskStatus.CANCELLED, reason)
         if self.current is not None and task_id in (None, self.current.id):
             hit.append(self.current)
             self.stop_current(Stop(TaskStatus.CANCELLED, reason))
         return hit
 
+    def fail(self, reason: str) -> None:
+        """The robot broke: its running (or starting) task fails, the queued ones are cancelled."""
+        taken = self._taken()
+        if taken is not None:
+            self._drop(taken, TaskStatus.FAILED, reason)
+        for task in list(self.queue.items):
+            self._drop(task, TaskStatus.CANCELLED, reason)
+        self.stop_current(Stop(TaskStatus.FAILED, reason))
+
     def preempt(self, task: Task, reason: str = "preempted") -> simpy.Event:
         """Put ``task`` first and interrupt the running task, which ends ``preempted``."""
+        taken = self._taken()
+        if taken is not None:  # about to start: it is preempted before its first step
+            self._drop(taken, TaskStatus.PREEMPTED, reason)
         done = self.submit(task, front=True)
         self.stop_current(Stop(TaskStatus.PREEMPTED, reason))
         return done
@@ -69,19 +87,29 @@ class TaskHandler:
         if self._active is not None and self._active.is_alive:
             self._active.interrupt(cause)
 
+    def _drop(self, task: Task, status: TaskStatus, reason: str) -> None:
+        """End a task that has not started: take it out of the queue, or skip it if taken."""
+        if task in self.queue.items:
+            self.queue.items.remove(task)
+        else:
+            self._dropped.add(task.id)
+        self._settle(task, ActionResult(status, reason, self.env.now, self.env.now))
+
     def _work(self) -> Generator[simpy.Event, Any, None]:
         while True:
-            task = yield self.queue.get()
+            self._get = self.queue.get()
+            task = yield self._get
+            self._get = None
+            if task.id in self._dropped:
+                self._dropped.discard(task.id)
+                continue
             self.current = task
+            # The action's first step always precedes any interrupt sent from here on
+            # (SimPy runs the process's initialisation first), so the action sees it.
+            self._active = self.env.process(self._run(task))
             if self._on_change is not None:
                 self._on_change(task, None)
-            self._active = self.env.process(self._run(task))
-            try:
-                result = yield self._active
-            except simpy.Interrupt as stop:  # interrupted before its first step
-                cause = stop.cause
-                assert isinstance(cause, Stop)
-                result = ActionResult(cause.status, cause.message, self.env.now, self.env.now)
+            result = yield self._active
             self._active = None
             self.current = None
             self._settle(task, result)

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any, cast
 
 import simpy
 
-from astralis_des.kernel.tasks import ActionResult, Stop, TaskStatus
+from astralis_des.kernel.tasks import ActionResult
 from astralis_des.mission.spec import (
     CancelEvent,
     CommandEvent,
@@ -71,11 +71,7 @@ def _fault(sim: Simulation, event: FaultEvent) -> None:
     robot = sim.robots[event.robot]
     robot.faulted = True
     sim.log.emit("fault", event.robot, reason=event.reason)
-    handler = sim.handler(event.robot)
-    queued = [t for t in handler.queued]
-    for task in queued:
-        handler.cancel(task.id, f"robot fault: {event.reason}")
-    handler.stop_current(Stop(TaskStatus.FAILED, f"robot fault: {event.reason}"))
+    sim.handler(event.robot).fail(f"robot fault: {event.reason}")
 
 
 @TIMELINE_EVENTS.register("recover")

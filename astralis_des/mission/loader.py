@@ -28,10 +28,13 @@ class Mission:
         return self.spec.name
 
     def with_changes(self, **changes: Any) -> Mission:
-        """A copy with top-level spec fields replaced (e.g. ``seed=3``), re-validated."""
-        data = self.spec.model_dump()
+        """A copy with top-level spec fields replaced (e.g. ``seed=3``), checked like a file."""
+        data = self.spec.model_dump(mode="json")
         data.update(changes)
-        return replace(self, spec=MissionSpec.model_validate(data))
+        doc = LocatedYaml(data, {}, self.path or Path("<mission>"))
+        spec = _validate(doc)
+        _check_references(spec, self.world, doc)
+        return replace(self, spec=spec)
 
     def searched_rooms(self) -> list[str]:
         """Rooms of the searched buildings or segments, in search order."""
@@ -49,7 +52,7 @@ class Mission:
 def load_mission(path: str | Path) -> Mission:
     """Read a mission file; any problem is an :class:`InputError` naming file, line and key."""
     doc = load_yaml(path)
-    spec = validate(MissionSpec, doc)
+    spec = _validate(doc)
     world_path = (doc.file.parent / spec.world).resolve()
     if not world_path.is_file():
         raise doc.error(("world",), f"no such world file: {world_path}")
@@ -58,8 +61,28 @@ def load_mission(path: str | Path) -> Mission:
     return Mission(spec, world, doc.file)
 
 
+def _validate(doc: LocatedYaml) -> MissionSpec:
+    check_unique_ids(doc, "team")
+    return validate(MissionSpec, doc)
+
+
+def check_unique_ids(doc: LocatedYaml, key: str) -> None:
+    """Point at the second use of an id in the list ``key``, with the line of the first."""
+    items = doc.data.get(key) if isinstance(doc.data, dict) else None
+    seen: dict[object, int] = {}
+    for i, item in enumerate(items if isinstance(items, list) else []):
+        ident = item.get("id") if isinstance(item, dict) else None
+        if ident is None or not isinstance(ident, str | int):
+            continue
+        if ident in seen:
+            first = doc.line_of((key, seen[ident], "id"))
+            raise doc.error((key, i, "id"), f"id '{ident}' is used twice"
+                            + (f" (first at line {first})" if first else ""))
+        seen[ident] = i
+
+
 def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None:
-    from astralis_des.actions import ACTIONS
+    from astralis_des.actions import ACTIONS, actions_for
     from astralis_des.assignment.strategies import STRATEGIES
 
     def room(value: str, path: KeyPath) -> None:
@@ -104,11 +127,11 @@ def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None
         event_room = getattr(event, "room", None)
         if event_room is not None:
             room(event_room, ("timeline", i, "room"))
-        if isinstance(event, CommandEvent):
-            try:
-                ACTIONS.get((kinds[event.robot], event.action))
-            except UnknownEntry as exc:
-                raise doc.error(("timeline", i, "action"), str(exc)) from None
+        if isinstance(event, CommandEvent) and (kinds[event.robot], event.action) not in ACTIONS:
+            kind = kinds[event.robot]
+            raise doc.error(("timeline", i, "action"),
+                            f"a {kind} has no action '{event.action}'; "
+                            f"{suggest(event.action, actions_for(kind))}")
     if spec.timeline and max(e.at for e in spec.timeline) > spec.time_limit:
         late = max(range(len(spec.timeline)), key=lambda k: spec.timeline[k].at)
         raise doc.error(("timeline", late, "at"), "this event comes after time_limit")

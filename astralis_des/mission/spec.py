@@ -4,16 +4,13 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import (
-    BaseModel,
-    ConfigDict,
-    Field,
-    NonNegativeFloat,
-    PositiveFloat,
-    model_validator,
-)
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-Vec3 = tuple[float, float, float]
+# Every number is finite: no .inf time limits, no .nan positions.
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegativeFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Vec3 = tuple[Finite, Finite, Finite]
 Kind = Literal["uav", "ugv", "human"]
 Unit = Annotated[float, Field(ge=0.0, le=1.0)]
 Sound = Literal["minimal", "moderate", "loud"]
@@ -157,10 +154,11 @@ class MissionSpec(Strict):
     timeline: list[TimelineEvent] = Field(default_factory=list)
     outputs: OutputsSpec = Field(default_factory=OutputsSpec)
 
-    @model_validator(mode="after")
-    def _unique_ids(self) -> MissionSpec:
-        ids = [m.id for m in self.team]
+    @field_validator("team")
+    @classmethod
+    def _unique_ids(cls, team: list[MemberSpec]) -> list[MemberSpec]:
+        ids = [m.id for m in team]
         duplicates = sorted({i for i in ids if ids.count(i) > 1})
         if duplicates:
             raise ValueError(f"team ids must be unique; repeated: {', '.join(duplicates)}")
-        return self
+        return team

@@ -41,10 +41,28 @@ def build_world(spec: WorldSpec) -> World:
 @lru_cache(maxsize=16)
 def load_world(path: Path) -> World:
     """Read, validate and build a world file; cached, since a world never changes."""
+    from astralis_des.mission.loader import check_unique_ids
     from astralis_des.validation import validate
     from astralis_des.yamlio import load_yaml
 
-    return build_world(validate(WorldSpec, load_yaml(path)))
+    doc = load_yaml(path)
+    check_unique_ids(doc, "buildings")
+    spec = validate(WorldSpec, doc)
+    world = build_world(spec)
+    footprints = [world.buildings[b.id].footprint for b in spec.buildings]
+    for i, box in enumerate(footprints):
+        if box.lo[0] < 0 or box.lo[1] < 0 or box.hi[0] > spec.site.size[0] or \
+                box.hi[1] > spec.site.size[1]:
+            raise doc.error(("buildings", i, "origin"),
+                            f"building {spec.buildings[i].id} reaches outside the site "
+                            f"({box.hi[0]:g} x {box.hi[1]:g} m at its far corner)")
+        for j in range(i):
+            other = footprints[j]
+            if all(box.lo[k] < other.hi[k] and other.lo[k] < box.hi[k] for k in (0, 1)):
+                raise doc.error(("buildings", i, "origin"),
+                                f"building {spec.buildings[i].id} overlaps building "
+                                f"{spec.buildings[j].id}")
+    return world
 
 
 def _add_building(b: BuildingSpec, parts: _Parts) -> Building:

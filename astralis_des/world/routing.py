@@ -141,10 +141,11 @@ class Router:
         for space in self.world.spaces.values():
             if space.box.contains(p, margin=0.05):
                 return space.id
+        where = "[" + ", ".join(f"{v:g}" for v in np.round(p, 2)) + "]"
         if not self.world.contains(p):
-            raise InputError(f"point {tuple(np.round(p, 2))} is outside the world")
+            raise InputError(f"point {where} is outside the world")
         if not self._outdoor_clear(p[None, :], p[None, :])[0]:
-            raise InputError(f"point {tuple(np.round(p, 2))} is inside a building or obstacle")
+            raise InputError(f"point {where} is inside a building or obstacle")
         return "outdoor"
 
     def _entries(self, p: FloatArray, place: str) -> list[int]:

@@ -4,7 +4,15 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PositiveFloat,
+    PositiveInt,
+    field_validator,
+    model_validator,
+)
 
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
@@ -64,9 +72,10 @@ class WorldSpec(Strict):
     buildings: list[BuildingSpec] = Field(min_length=1)
     obstacles: list[ObstacleSpec] = Field(default_factory=list)
 
-    @model_validator(mode="after")
-    def _unique_ids(self) -> WorldSpec:
-        ids = [b.id for b in self.buildings]
+    @field_validator("buildings")
+    @classmethod
+    def _unique_ids(cls, buildings: list[BuildingSpec]) -> list[BuildingSpec]:
+        ids = [b.id for b in buildings]
         if len(ids) != len(set(ids)):
             raise ValueError(f"building ids must be unique, got {ids}")
-        return self
+        return buildings
