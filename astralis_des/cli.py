@@ -153,8 +153,7 @@ def _print_summary(console: Any, result: RunResult, out: Path) -> None:
                   f"{result.end_time:.1f} s simulated in {result.wall_time:.2f} s")
     table = Table(title="team")
     table.add_column("robot", no_wrap=True)
-    for header in ("kind", "distance (m)", "busy (s)", "idle (s)", "tasks ok", "failed",
-                   "cancelled", "preempted"):
+    for header in ("kind", "dist m", "busy s", "idle s", "ok", "failed", "cancel", "preempt"):
         table.add_column(header, justify="right" if header != "kind" else "left")
     for rid, s in result.robots.items():
         table.add_row(rid, s.kind, f"{s.distance:.1f}", f"{s.busy_time:.1f}",
