@@ -51,19 +51,19 @@ def test_fig7_reproduces_the_papers_assignment() -> None:
 
 
 def test_faults_mission_fails_retries_preempts_and_recovers() -> None:
-    """uav2 fails mid-spiral at 19 s; its room is retried; ugv1 is preempted at 60 s."""
+    """uav2 fails mid-spiral at 25 s; its room is retried; ugv1 is preempted at 35 s."""
     result = Simulation(load_mission(Path(MISSIONS[0]).parent / "faults.yaml")).run()
     finished = [e for e in result.events if e["kind"] == "task_finished"]
     failed = [e for e in finished if e["status"] == "failed"]
-    assert [(e["t"], e["robot"]) for e in failed] == [(19.0, "uav2")]
+    assert [(e["t"], e["robot"], e["action"]) for e in failed] == [(25.0, "uav2", "spiral_inward")]
     retried = failed[0]["room"]
-    later = [r for r in result.rounds if r["t"] > 19.0]
+    later = [r for r in result.rounds if r["t"] > 25.0]
     assert any(m["room"] == retried for r in later for m in r["matching"])
     assert all("uav2" not in r["agents"] for r in later if r["t"] < 100.0)
     assert any("uav2" in r["agents"] for r in later if r["t"] >= 100.0)
     preempted = [e for e in finished if e["status"] == "preempted"]
-    assert [(e["t"], e["robot"]) for e in preempted] == [(60.0, "ugv1")]
-    started = [e for e in result.events if e["kind"] == "task_started" and e["t"] == 60.0]
+    assert [(e["t"], e["robot"]) for e in preempted] == [(35.0, "ugv1")]
+    started = [e for e in result.events if e["kind"] == "task_started" and e["t"] == 35.0]
     assert started[0]["robot"] == "ugv1" and started[0]["action"] == "sneak_peek"
     change = next(e for e in result.events if e["kind"] == "room_change")
     round_a21 = next(r for r in result.rounds if r["segment"] == "A.2.1")

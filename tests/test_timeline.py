@@ -17,7 +17,9 @@ import pytest
 
 from astralis_des import InputError, Mission, RunResult, Simulation, load_mission
 from astralis_des.assignment import table4_action
+from astralis_des.kinds import KIND_DEFAULTS
 
+UAV_SPEED = KIND_DEFAULTS["uav"].speed
 MISSION = Path(__file__).resolve().parents[1] / "missions" / "urban_search.yaml"
 
 
@@ -71,12 +73,12 @@ def test_fault_fails_the_running_task(mission: Mission) -> None:
     assert (move["robot"], move["action"], move["t"]) == ("uav1", "move", 10.0)
     assert move["status"] == "failed"
     assert move["message"] == "robot fault: rotor"
-    assert move["distance"] == pytest.approx(20.0)  # 2 m/s for 10 s
+    assert move["distance"] == pytest.approx(10.0 * UAV_SPEED)  # at cruise speed for 10 s
     spiral = finished(result, 2)
     assert (spiral["action"], spiral["t"], spiral["status"]) == ("spiral_inward", 10.0,
                                                                  "cancelled")
     assert result.robots["uav1"].faulted is True
-    assert result.robots["uav1"].distance == pytest.approx(20.0)
+    assert result.robots["uav1"].distance == pytest.approx(10.0 * UAV_SPEED)
 
 
 def test_faulted_robot_takes_no_later_round(mission: Mission) -> None:
@@ -174,7 +176,7 @@ def test_command_with_preempt(mission: Mission) -> None:
                                      "preempt": True}])
     move = finished(result, 3)
     assert (move["action"], move["t"], move["status"]) == ("move", 10.0, "preempted")
-    assert move["distance"] == pytest.approx(20.0)
+    assert move["distance"] == pytest.approx(10.0 * UAV_SPEED)
     order = [(e["kind"], e["task"], e["t"]) for e in result.events
              if e.get("robot") == "uav2" and e["kind"] in ("task_started", "task_finished")]
     hover = next(e["task"] for e in events(result, "task_queued", "uav2")

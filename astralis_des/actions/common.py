@@ -21,8 +21,14 @@ StepGen = Generator[simpy.Event, Any, float]
 
 class CoSim(Protocol):
     def execute(self, robot: Robot, motion: Motion) -> simpy.Event: ...
+    def watch(self, robot: Robot, motion: Motion, sensor: GeometricSensor,
+              done: simpy.Event) -> simpy.Event: ...
     def dwell(self, robot: Robot, seconds: float) -> simpy.Event: ...
     def halt(self, robot: Robot) -> None: ...
+
+
+class MotionFailed(Exception):
+    """A motion ended without arriving; the action ends ``failed`` with this reason."""
 
 
 class Context(Protocol):
@@ -65,15 +71,17 @@ def route(ctx: Context, robot: Robot,
 def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> StepGen:
     """Follow ``points``; when sensing, report the target the moment it comes into view."""
     before = robot.distance
-    motion = Motion(points, robot.speed)
+    motion = Motion(points, robot.speed, turn_rate=robot.turn_rate, heading=robot.heading)
     done = ctx.cosim.execute(robot, motion)
     if sense:
-        hit = ctx.sensor.first_sighting(robot, motion)
-        if hit is not None:
-            yield ctx.env.timeout(hit.t)
-            ctx.report_detection(robot, hit)
-    yield done
+        seen = ctx.cosim.watch(robot, motion, ctx.sensor, done)
+        yield seen | done
+        if seen.triggered and seen.value is not None:
+            ctx.report_detection(robot, seen.value)
+    outcome = yield done
     ctx.cosim.halt(robot)
+    if not outcome.ok:
+        raise MotionFailed(outcome.reason)
     return robot.distance - before
 
 

@@ -2,21 +2,45 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
 import simpy
 
 from astralis_des.cosim import COSIMS
 from astralis_des.kernel.robot import Motion, Robot
+from astralis_des.sensing import GeometricSensor
+
+if TYPE_CHECKING:
+    from astralis_des.kernel.simulation import Simulation
+
+
+@dataclass(frozen=True)
+class MotionOutcome:
+    """How a motion ended: arrived, or failed with a reason (stuck, left the world, ...)."""
+
+    ok: bool
+    reason: str
+
+
+ARRIVED = MotionOutcome(True, "arrived")
 
 
 @COSIMS.register("kinematic")
 class KinematicCoSim:
-    def __init__(self, env: simpy.Environment) -> None:
-        self.env = env
+    def __init__(self, sim: Simulation) -> None:
+        self.env = sim.env
 
     def execute(self, robot: Robot, motion: Motion) -> simpy.Event:
-        """An event that succeeds with the motion when the robot arrives."""
+        """An event that succeeds with the motion's outcome when the robot arrives."""
         robot.begin(motion, self.env.now)
-        return self.env.timeout(motion.duration, value=motion)
+        return self.env.timeout(motion.duration, value=ARRIVED)
+
+    def watch(self, robot: Robot, motion: Motion, sensor: GeometricSensor,
+              done: simpy.Event) -> simpy.Event:
+        """An event that succeeds with the first sighting along the motion (never if none)."""
+        hit = sensor.first_sighting(robot, motion)
+        return self.env.timeout(hit.t, value=hit) if hit is not None else self.env.event()
 
     def dwell(self, robot: Robot, seconds: float) -> simpy.Event:
         robot.halt(self.env.now)
@@ -27,3 +51,5 @@ class KinematicCoSim:
 
     def close(self) -> None:
         """Nothing to release; the physics fidelity frees its client here."""
+
+    step_time = 0.0

@@ -26,8 +26,12 @@ class EventLog:
         self.records: list[Record] = []
         self.sinks: list[Sink] = []
 
-    def emit(self, kind: str, robot: str | None = None, **payload: Any) -> Record:
-        record: Record = {"t": round(float(self.env.now), 6), "kind": kind}
+    def emit(self, kind: str, robot: str | None = None, *, at: float | None = None,
+             **payload: Any) -> Record:
+        """Record an event now, or ``at`` a time between now and the next pending event (the
+        physics stepper's time inside a macro-step)."""
+        t = self.env.now if at is None else at
+        record: Record = {"t": round(float(t), 6), "kind": kind}
         if robot is not None:
             record["robot"] = robot
         record.update({k: plain(v) for k, v in payload.items()})

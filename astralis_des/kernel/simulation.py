@@ -13,8 +13,9 @@ import numpy as np
 import simpy
 
 from astralis_des.actions import ACTIONS
+from astralis_des.actions.common import MotionFailed
 from astralis_des.assignment import Agent, Assignment, RoomInfo, Weights, assign
-from astralis_des.cosim import COSIMS
+from astralis_des.cosim import load_fidelity
 from astralis_des.kernel.events import EventLog
 from astralis_des.kernel.handler import TaskHandler
 from astralis_des.kernel.result import RunResult, build_result
@@ -45,7 +46,6 @@ class Simulation:
         self.rooms = draw_rooms(mission)
         self.target = draw_target(mission)
         self.sensor = GeometricSensor(self.world, np.array(self.target.position))
-        self.cosim = COSIMS.get(spec.fidelity)(self.env)
         self.found = self.env.event()
         self.rounds: list[dict[str, Any]] = []
         self.searched: list[str] = []
@@ -56,6 +56,7 @@ class Simulation:
         self._started: dict[str, tuple[int, float]] = {}  # robot -> running task, its start
         self._handlers: dict[str, TaskHandler] = {}
         self.robots = {m.id: self._make_robot(m) for m in spec.team}
+        self.cosim = load_fidelity(spec.fidelity)(self)
 
     # -- set-up ----------------------------------------------------------------------------
     def _make_robot(self, member: MemberSpec) -> Robot:
@@ -67,7 +68,8 @@ class Simulation:
             start = np.array(member.start, dtype=float)
         start = start + np.array([0.0, 0.0, height])
         robot = Robot(member.id, member.kind, member.speed or d.speed,
-                      member.detection_radius or d.detection_radius, height, start)
+                      member.detection_radius or d.detection_radius, height, start,
+                      turn_rate=d.turn_rate)
         robot.trail_t.append(0.0)
         robot.trail_p.append(start.copy())
 
@@ -101,6 +103,10 @@ class Simulation:
         try:
             action = ACTIONS.get((robot.kind, task.action))
             outcome = yield from action(self, robot, task)
+        except MotionFailed as failure:
+            self.cosim.halt(robot)
+            outcome = ActionResult(TaskStatus.FAILED, str(failure),
+                                   distance=robot.distance - travelled)
         except simpy.Interrupt as stop:
             cause = stop.cause if isinstance(stop.cause, Stop) else Stop(
                 TaskStatus.CANCELLED, str(stop.cause))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 # Every number is finite: no .inf time limits, no .nan positions.
 Finite = Annotated[float, Field(allow_inf_nan=False)]
@@ -134,6 +134,56 @@ TimelineEvent = Annotated[
 ]
 
 
+class HexacopterSpec(Strict):
+    """A Firefly-like hexacopter (RotorS constants): six rotors on arms, thrust k_f w^2 per
+    rotor, drag torque k_m x thrust, rotor speeds limited; a cascaded controller flies it."""
+
+    mass: PositiveFloat = 1.5
+    arm_length: PositiveFloat = 0.215
+    inertia: tuple[PositiveFloat, PositiveFloat, PositiveFloat] = (0.0347563, 0.0458929, 0.0977)
+    thrust_constant: PositiveFloat = Field(8.54858e-06, description="k_f, N/(rad/s)^2")
+    moment_constant: PositiveFloat = Field(0.016, description="k_m, m: drag torque/thrust")
+    max_rotor_speed: PositiveFloat = Field(838.0, description="rad/s")
+    motor_time_constant: NonNegativeFloat = 0.0125
+    max_tilt_deg: Annotated[float, Field(gt=0, lt=60)] = 25.0
+    max_accel: PositiveFloat = Field(4.5, description="m/s^2, commanded horizontal")
+    radius: PositiveFloat = Field(0.3, description="m, collision cylinder (rotor tips)")
+
+    @model_validator(mode="after")
+    def _can_lift(self) -> HexacopterSpec:
+        lift = 6 * self.thrust_constant * self.max_rotor_speed**2
+        if lift <= self.mass * 9.81 * 1.2:
+            raise ValueError(f"six rotors lift {lift:.1f} N at most: not enough for "
+                             f"{self.mass} kg with a margin (needs {self.mass * 9.81 * 1.2:.1f})")
+        return self
+
+
+class PhysicsSpec(Strict):
+    """The physics fidelity: a PyBullet co-simulation, stepped at ``rate`` Hz."""
+
+    rate: Annotated[int, Field(ge=30, le=2000)] = Field(240, description="physics steps per s")
+    control_rate: Annotated[int, Field(ge=10, le=2000)] = Field(
+        120, description="controller updates per s; must divide rate")
+    log_rate: PositiveFloat = Field(10.0, description="pose samples per s in the recording")
+    stuck_timeout: PositiveFloat = Field(15.0, description="s without progress: the action fails")
+    solver_iterations: Annotated[int, Field(ge=1, le=200)] = 20
+    uav: HexacopterSpec = Field(default_factory=HexacopterSpec)
+
+    @model_validator(mode="after")
+    def _rates(self) -> PhysicsSpec:
+        if self.control_rate > self.rate:
+            raise ValueError(f"control_rate {self.control_rate} Hz is faster than the physics "
+                             f"rate {self.rate} Hz: a controller period is shorter than dt")
+        if self.rate % self.control_rate:
+            raise ValueError(f"control_rate {self.control_rate} Hz does not divide the physics "
+                             f"rate {self.rate} Hz")
+        return self
+
+    @property
+    def dt(self) -> float:
+        return 1.0 / self.rate
+
+
 class OutputsSpec(Strict):
     dir: str | None = Field(None, description="default: out/<mission name>")
     events: bool = True
@@ -145,13 +195,14 @@ class MissionSpec(Strict):
     name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
     world: str = Field(description="world file, relative to the mission file")
     seed: int = 0
-    fidelity: Literal["kinematic"] = "kinematic"
+    fidelity: Literal["kinematic", "physics"] = "kinematic"
     time_limit: PositiveFloat = 3600.0
     team: list[MemberSpec] = Field(min_length=1)
     rooms: RoomsSpec = Field(default_factory=RoomsSpec)
     target: TargetSpec = Field(default_factory=TargetSpec)
     assignment: AssignmentSpec = Field(default_factory=AssignmentSpec)
     timeline: list[TimelineEvent] = Field(default_factory=list)
+    physics: PhysicsSpec = Field(default_factory=PhysicsSpec)
     outputs: OutputsSpec = Field(default_factory=OutputsSpec)
 
     @field_validator("team")

@@ -1,0 +1,223 @@
+"""Physics fidelity: a PyBullet co-simulation behind the kinematic contract.
+
+One stepper process advances the physics in whole control periods (``substeps`` physics steps
+of ``dt`` each) while at least one controller is active, in macro-steps up to the next pending
+event (``env.peek()``), stopping early when a controller finishes; then it yields
+``env.timeout`` for the time stepped and fires the completion events. With nothing moving it
+waits on an event, so idle time costs nothing. Physics time is quantised to the control
+period: an event between two ticks sees the state of the last one.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import tempfile
+from collections.abc import Generator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import simpy
+
+from astralis_des.cosim import COSIMS
+from astralis_des.cosim.kinematic import MotionOutcome
+from astralis_des.kernel.robot import Motion, Robot
+from astralis_des.physics.client import PhysicsClient
+from astralis_des.physics.drivers import DRIVERS, Driver
+from astralis_des.physics.hexacopter import write_urdf
+from astralis_des.sensing import GeometricSensor, Sighting
+from astralis_des.world.geometry import FloatArray
+
+if TYPE_CHECKING:
+    from astralis_des.kernel.simulation import Simulation
+
+CONTACT_CHECKS_PER_S = 30
+PROGRESS = 0.1  # m a moving robot must cover within stuck_timeout
+SUPPORT = 0.7  # a contact normal steeper than this holds a ground robot up: not a collision
+
+
+@dataclass
+class Track:
+    """The motion of a robot in physics: its pose is read from the body; the trail and the
+    distance are sampled as it goes."""
+
+    driver: Driver
+    t0: float
+    times: list[float] = field(default_factory=list)
+    points: list[FloatArray] = field(default_factory=list)
+    odometry: float = 0.0
+    checkpoint: tuple[float, FloatArray] | None = None
+
+    def sample(self, t: float) -> FloatArray:
+        here = self.driver.position()
+        if self.points:
+            self.odometry += float(np.linalg.norm(here - self.points[-1]))
+        self.times.append(t)
+        self.points.append(here)
+        return here
+
+    def at(self, t: float) -> FloatArray:
+        return self.driver.position()
+
+    def travelled(self, t: float) -> float:
+        return self.odometry + float(np.linalg.norm(self.driver.position() - self.points[-1]))
+
+    def vertices_until(self, t: float) -> tuple[FloatArray, FloatArray]:
+        return (np.append(self.times, t),
+                np.vstack([*self.points, self.driver.position()[None, :]]))
+
+
+@COSIMS.register("physics")
+class PhysicsCoSim:
+    def __init__(self, sim: Simulation) -> None:
+        spec = sim.mission.spec.physics
+        self.env, self.log, self.spec = sim.env, sim.log, spec
+        self.period = 1.0 / spec.control_rate
+        self.client = PhysicsClient(sim.world, spec.dt, spec.rate // spec.control_rate,
+                                    spec.solver_iterations)
+        self._folder = Path(tempfile.mkdtemp(prefix="astralis-"))
+        urdf = write_urdf(spec.uav, self._folder)
+        self.drivers: dict[str, Driver] = {
+            rid: DRIVERS.get(robot.kind)(self.client, robot, spec, urdf)
+            for rid, robot in sim.robots.items()}
+        self.names = {d.body: rid for rid, d in self.drivers.items()}
+        self.names.update({self.client.static: "wall", self.client.ground: "ground"})
+        self.site = sim.world.site
+        self.active: dict[str, tuple[Robot, Track, simpy.Event]] = {}
+        self.touching: set[tuple[str, str]] = set()
+        self.t = 0.0  # physics time: whole control periods
+        self._wake: simpy.Event = self.env.event()
+        self._next_log = 0.0
+        self._ticks = 0
+        self.env.process(self._stepper())
+
+    # -- the co-simulation contract ------------------------------------------------------
+    def execute(self, robot: Robot, motion: Motion) -> simpy.Event:
+        self.halt(robot)
+        driver = self.drivers[robot.id]
+        motion.t0 = self.env.now
+        driver.start(motion, self.env.now)
+        track = Track(driver, self.env.now)
+        track.sample(self.env.now)
+        track.checkpoint = (self.env.now, track.points[-1])
+        robot.begin(track, self.env.now)  # type: ignore[arg-type]
+        done = self.env.event()
+        self.active[robot.id] = (robot, track, done)
+        if not self._wake.triggered:
+            self._wake.succeed()
+        return done
+
+    def dwell(self, robot: Robot, seconds: float) -> simpy.Event:
+        self.halt(robot)
+        return self.env.timeout(seconds)
+
+    def halt(self, robot: Robot) -> None:
+        if self.active.pop(robot.id, None) is not None:
+            self.drivers[robot.id].freeze()
+        robot.halt(self.env.now)
+
+    def watch(self, robot: Robot, motion: Motion, sensor: GeometricSensor,
+              done: simpy.Event) -> simpy.Event:
+        """Look for the target from where the body really is, at the log rate."""
+        return self.env.process(self._watch(robot, sensor, done))
+
+    def _watch(self, robot: Robot, sensor: GeometricSensor,
+               done: simpy.Event) -> Generator[simpy.Event, Any, Sighting | None]:
+        track = robot.motion
+        while not done.triggered and robot.motion is track:
+            hit = sensor.sighting_from(robot, robot.position(self.env.now))
+            if hit is not None:
+                return hit
+            yield self.env.timeout(1.0 / self.spec.log_rate)
+        return None
+
+    def close(self) -> None:
+        self.client.close()
+        shutil.rmtree(self._folder, ignore_errors=True)
+
+    @property
+    def step_time(self) -> float:
+        return self.client.step_time
+
+    # -- the stepper -----------------------------------------------------------------------
+    def _stepper(self) -> Generator[simpy.Event, Any, None]:
+        env = self.env
+        while True:
+            if not self.active:
+                self._wake = env.event()
+                yield self._wake
+                self.t = math.ceil(env.now / self.period - 1e-9) * self.period
+                if self.t > env.now:
+                    yield env.timeout(self.t - env.now)
+                continue
+            ticks = math.floor((env.peek() - self.t) / self.period + 1e-9)
+            if ticks < 1:  # an event falls before the next tick: let it see this state
+                yield env.timeout(max(env.peek() - env.now, 0.0))
+                continue
+            finished = self._advance(ticks)
+            yield env.timeout(max(self.t - env.now, 0.0))
+            for rid, outcome in finished:
+                self._finish(rid, outcome)
+
+    def _advance(self, ticks: int) -> list[tuple[str, MotionOutcome]]:
+        """Step up to ``ticks`` control periods; stop at the first that ends a motion."""
+        check_every = max(1, round(1.0 / (CONTACT_CHECKS_PER_S * self.period)))
+        for _ in range(ticks):
+            finished = [(rid, out) for rid, (robot, track, _) in self.active.items()
+                        if (out := self._tick(rid, track)) is not None]
+            if finished:
+                return finished
+            self.client.step()
+            self.t += self.period
+            self._ticks += 1
+            if self._ticks % check_every == 0:
+                self._contacts()
+            if self.t >= self._next_log:
+                self._next_log = self.t + 1.0 / self.spec.log_rate
+                for _, track, _ in self.active.values():
+                    track.sample(self.t)
+        return []
+
+    def _tick(self, rid: str, track: Track) -> MotionOutcome | None:
+        status = track.driver.tick(self.t)
+        if status == "arrived":
+            return MotionOutcome(True, "arrived")
+        here = track.driver.position()
+        if not np.all(np.isfinite(here)):
+            return MotionOutcome(False, "the physics state became NaN")
+        if not (-5.0 <= here[0] <= self.site[0] + 5.0 and -5.0 <= here[1] <= self.site[1] + 5.0
+                and -1.0 <= here[2] <= 200.0):
+            return MotionOutcome(False, "left the world")
+        since, where = track.checkpoint or (self.t, here)
+        if float(np.linalg.norm(here - where)) > PROGRESS:
+            track.checkpoint = (self.t, here)
+        elif self.t - since > self.spec.stuck_timeout:
+            return MotionOutcome(False, f"stuck: no progress for {self.spec.stuck_timeout:g} s")
+        return None
+
+    def _finish(self, rid: str, outcome: MotionOutcome) -> None:
+        robot, track, done = self.active.pop(rid)
+        track.sample(self.env.now)
+        self.drivers[rid].freeze()
+        robot.halt(self.env.now)
+        done.succeed(outcome)
+
+    def _contacts(self) -> None:
+        """A robot touching a wall, the ground (a UAV) or another robot: one event a touch."""
+        now: set[tuple[str, str]] = set()
+        impulses: dict[tuple[str, str], float] = {}
+        for rid, (robot, _, _) in self.active.items():
+            body = self.drivers[rid].body
+            for c in self.client.call("getContactPoints", bodyA=body):
+                other = self.names.get(c[2], "object")
+                if robot.kind != "uav" and other in ("wall", "ground") and c[7][2] > SUPPORT:
+                    continue  # wheels or feet on a floor
+                key = (rid, other)
+                now.add(key)
+                impulses[key] = impulses.get(key, 0.0) + c[9] * self.client.dt
+        for key in sorted(now - self.touching):
+            self.log.emit("contact", key[0], at=self.t, other=key[1],
+                          impulse=round(impulses[key], 4))
+        self.touching = now

@@ -1,0 +1,87 @@
+"""One PyBullet client per simulation, holding the world's static geometry."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import time
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import pybullet as pb
+import pybullet_data
+
+from astralis_des.world.model import World
+
+GRAVITY = 9.81
+
+
+@contextlib.contextmanager
+def quiet_c_output() -> Iterator[None]:
+    """Silence what the C library prints on stdout (URDF importer warnings)."""
+    try:
+        fd = os.dup(1)
+    except OSError:  # no stdout to silence
+        yield
+        return
+    with open(os.devnull, "w") as devnull:
+        os.dup2(devnull.fileno(), 1)
+        try:
+            yield
+        finally:
+            os.dup2(fd, 1)
+            os.close(fd)
+
+
+class PhysicsClient:
+    """A DIRECT-mode PyBullet client with the world's walls, slabs and obstacles in it.
+
+    The static geometry is one compound body of boxes (simple shapes, one broadphase entry);
+    the ground is a plane. ``step`` counts the wall time spent inside ``stepSimulation``.
+    """
+
+    def __init__(self, world: World, dt: float, substeps: int, solver_iterations: int) -> None:
+        self.id = pb.connect(pb.DIRECT)
+        self.dt = dt
+        self.substeps = substeps
+        self.step_time = 0.0  # seconds of wall time inside stepSimulation
+        self.steps = 0  # physics steps of dt taken
+        self.call("setAdditionalSearchPath", pybullet_data.getDataPath())
+        self.call("setGravity", 0.0, 0.0, -GRAVITY)
+        self.call("setPhysicsEngineParameter", fixedTimeStep=dt * substeps,
+                  numSubSteps=substeps, numSolverIterations=solver_iterations,
+                  deterministicOverlappingPairs=1)
+        plane = self.call("createCollisionShape", pb.GEOM_PLANE)
+        self.ground = self.call("createMultiBody", 0, plane)
+        self.static = self._add_static(world)
+
+    def call(self, name: str, *args: Any, **kwargs: Any) -> Any:
+        """``pybullet.<name>(*args, **kwargs)`` on this client."""
+        return getattr(pb, name)(*args, physicsClientId=self.id, **kwargs)
+
+    def _add_static(self, world: World) -> int:
+        lo = np.array([s.box.lo for s in world.solids])
+        hi = np.array([s.box.hi for s in world.solids])
+        shape = self.call("createCollisionShapeArray", [pb.GEOM_BOX] * len(lo),
+                          halfExtents=((hi - lo) / 2).tolist(),
+                          collisionFramePositions=((hi + lo) / 2).tolist())
+        return int(self.call("createMultiBody", 0, shape))
+
+    def step(self, calls: int = 1) -> None:
+        """Advance ``calls`` x ``substeps`` physics steps of ``dt``."""
+        t0 = time.perf_counter()
+        for _ in range(calls):
+            pb.stepSimulation(physicsClientId=self.id)
+        self.step_time += time.perf_counter() - t0
+        self.steps += calls * self.substeps
+
+    def set_substeps(self, substeps: int) -> None:
+        if substeps != self.substeps:
+            self.substeps = substeps
+            self.call("setPhysicsEngineParameter", fixedTimeStep=self.dt * substeps,
+                      numSubSteps=substeps)
+
+    def close(self) -> None:
+        with contextlib.suppress(pb.error):
+            pb.disconnect(physicsClientId=self.id)

@@ -1,0 +1,179 @@
+"""Drivers: each robot kind's body and controller behind one interface for the stepper.
+
+``start(motion, t)`` begins a motion; ``tick(t)`` applies the commands for the next control
+period and returns ``None`` while the motion goes on, else ``"arrived"``; ``position()`` is
+the robot's pose (its sensor's position, as in the kinematic fidelity).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+
+from astralis_des.kernel.robot import Motion, Robot
+from astralis_des.mission.spec import PhysicsSpec
+from astralis_des.physics.client import PhysicsClient
+from astralis_des.physics.hexacopter import Hexacopter
+from astralis_des.physics.husky import Husky
+from astralis_des.physics.walker import HEIGHT, RADIUS, Walker
+from astralis_des.registry import Registry
+from astralis_des.world.geometry import FloatArray
+
+ARRIVED = 0.2  # m from the end of its path, nearly still: a UAV has arrived
+LIFT_RISE = 0.3  # m: a leg climbing more than this is ridden on the stairwell's vehicle lift
+
+
+class Driver(Protocol):
+    body: int
+
+    def start(self, motion: Motion, t: float) -> None: ...
+    def tick(self, t: float) -> str | None: ...
+    def position(self) -> FloatArray: ...
+    def freeze(self) -> None: ...
+
+
+DRIVERS: Registry[str, type] = Registry("driver")
+
+
+@DRIVERS.register("uav")
+class UavDriver:
+    """Flies a constant-speed reference along the path (the kinematic motion itself)."""
+
+    def __init__(self, client: PhysicsClient, robot: Robot, spec: PhysicsSpec, urdf: Path) -> None:
+        self.client = client
+        self.spec = spec.uav
+        self.craft = Hexacopter(client, spec.uav, urdf, robot.pose, 1.0 / spec.control_rate)
+        self.body = self.craft.body
+        self.motion: Motion | None = None
+        self.freeze()
+
+    def start(self, motion: Motion, t: float) -> None:
+        self.motion = motion
+        self.client.call("changeDynamics", self.body, -1, mass=self.spec.mass,
+                         localInertiaDiagonal=list(self.spec.inertia))
+        self.client.call("resetBaseVelocity", self.body, [0, 0, 0], [0, 0, 0])
+
+    def tick(self, t: float) -> str | None:
+        motion = self.motion
+        assert motion is not None
+        ref = motion.at(t)
+        if t < motion.t0 + motion.duration:
+            s = (t - motion.t0) * motion.speed
+            k = min(int(np.searchsorted(motion.cum, s, side="right")), len(motion.cum) - 1)
+            leg = motion.points[k] - motion.points[k - 1]
+            vel = leg / max(float(np.linalg.norm(leg)), 1e-9) * motion.speed
+        else:
+            vel = np.zeros(3)
+            pos, _, v, _ = self.craft.state()
+            if math.dist(pos, ref) < ARRIVED and math.hypot(*v) < 0.3:
+                return "arrived"
+        self.craft.control(ref, vel)
+        return None
+
+    def position(self) -> FloatArray:
+        return self.craft.position()
+
+    def freeze(self) -> None:
+        """Hold still as a static body: a waiting UAV costs the solver nothing."""
+        self.client.call("changeDynamics", self.body, -1, mass=0.0)
+        self.client.call("resetBaseVelocity", self.body, [0, 0, 0], [0, 0, 0])
+
+
+@DRIVERS.register("ugv")
+class UgvDriver:
+    """Pure pursuit on each floor; between floors the stairwell's lift carries it."""
+
+    def __init__(self, client: PhysicsClient, robot: Robot, spec: PhysicsSpec, urdf: Path) -> None:
+        self.client = client
+        self.height = robot.height
+        self.floor = float(robot.pose[2] - robot.height)
+        self.husky = Husky(client, robot.pose - np.array([0.0, 0.0, robot.height]))
+        self.body = self.husky.body
+        self.legs: list[tuple[bool, FloatArray]] = []
+        self.speed = robot.speed
+        self.lift: tuple[float, FloatArray] | None = None
+
+    def start(self, motion: Motion, t: float) -> None:
+        floor = motion.points - np.array([0.0, 0.0, self.height])
+        legs: list[tuple[bool, FloatArray]] = []
+        run = [floor[0]]
+        for a, b in itertools.pairwise(floor):
+            if abs(b[2] - a[2]) > LIFT_RISE:
+                if len(run) > 1:
+                    legs.append((False, np.array(run)))
+                legs.append((True, np.array([a, b])))
+                run = [b]
+            else:
+                run.append(b)
+        if len(run) > 1:
+            legs.append((False, np.array(run)))
+        self.legs = legs
+        self.speed = motion.speed
+        self._next_leg(t)
+
+    def _next_leg(self, t: float) -> None:
+        self.lift = None
+        if not self.legs:
+            return
+        ride, points = self.legs.pop(0)
+        if ride:
+            self.lift = (t, points)
+        else:
+            self.husky.follow(points, self.speed)
+
+    def tick(self, t: float) -> str | None:
+        if self.lift is not None:
+            t0, (a, b) = self.lift
+            share = min((t - t0) * self.speed / max(float(np.linalg.norm(b - a)), 1e-9), 1.0)
+            x, y, _z, yaw = self.husky.pose()
+            here = a + (b - a) * share
+            self.client.call("resetBasePositionAndOrientation", self.body,
+                             [x, y, float(here[2]) + 0.15],
+                             self.client.call("getQuaternionFromEuler", [0, 0, yaw]))
+            self.client.call("resetBaseVelocity", self.body, [0, 0, 0], [0, 0, 0])
+            self.floor = float(here[2])
+            if share >= 1.0:
+                self._next_leg(t)
+            return None
+        if self.husky.track():
+            self.floor = float(self.husky.path[-1][2])
+            if not self.legs:
+                return "arrived"
+            self._next_leg(t)
+        return None
+
+    def position(self) -> FloatArray:
+        x, y, _, _ = self.husky.pose()
+        return np.array([x, y, self.floor + self.height])
+
+    def freeze(self) -> None:
+        self.husky.drive(0.0, 0.0)
+
+
+@DRIVERS.register("human")
+class HumanDriver:
+    """Walks the path at its speed, kinematically: a capsule placed at each tick."""
+
+    def __init__(self, client: PhysicsClient, robot: Robot, spec: PhysicsSpec, urdf: Path) -> None:
+        self.offset = np.array([0.0, 0.0, robot.height - (RADIUS + HEIGHT / 2)])
+        self.walker = Walker(client, robot.pose - self.offset)
+        self.body = self.walker.body
+        self.motion: Motion | None = None
+
+    def start(self, motion: Motion, t: float) -> None:
+        self.motion = motion
+
+    def tick(self, t: float) -> str | None:
+        assert self.motion is not None
+        self.walker.place(self.motion.at(t) - self.offset)
+        return "arrived" if t >= self.motion.t0 + self.motion.duration else None
+
+    def position(self) -> FloatArray:
+        return self.walker.position() + self.offset
+
+    def freeze(self) -> None:
+        """A walker is kinematic: standing still costs nothing."""

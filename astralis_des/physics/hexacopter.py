@@ -1,0 +1,163 @@
+"""A Firefly-like hexacopter: its URDF, rotor mixer, motor lag and cascaded controller.
+
+Each rotor's thrust ``k_f w^2`` is applied as a force at the rotor; the rotors' drag torques
+``+-k_m f`` give the yaw. The controller is a cascade: position error -> desired velocity ->
+desired acceleration (tilt- and acceleration-limited) -> desired attitude and collective
+thrust -> attitude error (on SO(3)) -> desired body rates -> torques -> six rotor thrusts.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pybullet as pb
+
+from astralis_des.mission.spec import HexacopterSpec
+from astralis_des.physics.client import GRAVITY, PhysicsClient, quiet_c_output
+from astralis_des.world.geometry import FloatArray
+
+Vec = tuple[float, float, float] | FloatArray
+ROTORS = 6
+KP_POS = 1.2  # 1/s: position error -> velocity
+KV = 3.0  # 1/s: velocity error -> acceleration
+K_ATT = (7.0, 7.0, 2.0)  # 1/s: attitude error -> body rate
+K_RATE = (22.0, 22.0, 8.0)  # 1/s: rate error -> angular acceleration
+
+
+def write_urdf(spec: HexacopterSpec, folder: Path) -> Path:
+    """A one-link URDF: mass, inertia and a cylinder spanning the rotor tips."""
+    ixx, iyy, izz = spec.inertia
+    path = folder / "hexacopter.urdf"
+    path.write_text(f"""<?xml version="1.0"?>
+<robot name="hexacopter">
+  <link name="base_link">
+    <inertial>
+      <origin xyz="0 0 0"/>
+      <mass value="{spec.mass}"/>
+      <inertia ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/>
+    </inertial>
+    <collision>
+      <geometry><cylinder radius="{spec.radius}" length="0.12"/></geometry>
+    </collision>
+  </link>
+</robot>
+""", encoding="utf-8")
+    return path
+
+
+class Hexacopter:
+    """One hexacopter body in a client, and its controller."""
+
+    def __init__(self, client: PhysicsClient, spec: HexacopterSpec, urdf: Path,
+                 start: FloatArray, control_period: float) -> None:
+        self.client = client
+        self.spec = spec
+        self.period = control_period
+        with quiet_c_output():
+            self.body = int(client.call("loadURDF", str(urdf), list(map(float, start)),
+                                        flags=pb.URDF_USE_IMPLICIT_CYLINDER))
+        client.call("changeDynamics", self.body, -1, linearDamping=0.0, angularDamping=0.0)
+        angles = np.deg2rad(30.0 + 60.0 * np.arange(ROTORS))
+        self.rotors = spec.arm_length * np.column_stack(
+            [np.cos(angles), np.sin(angles), np.zeros(ROTORS)])
+        self.spin = np.array([1.0, -1.0] * (ROTORS // 2))  # alternate: yaw from drag torques
+        alloc = np.vstack([np.ones(ROTORS), self.rotors[:, 1], -self.rotors[:, 0],
+                           self.spin * spec.moment_constant])
+        self.mix = np.linalg.pinv(alloc)
+        self.max_thrust = spec.thrust_constant * spec.max_rotor_speed**2
+        self.inertia = np.array(spec.inertia)
+        hover = math.sqrt(spec.mass * GRAVITY / ROTORS / spec.thrust_constant)
+        self.tilt = math.tan(math.radians(spec.max_tilt_deg))
+        lag = spec.motor_time_constant
+        self.motor_alpha = 1.0 if lag == 0 else 1.0 - math.exp(-control_period / lag)
+        self.max_speed = 3.0
+        self.max_horizontal = min(spec.max_accel, GRAVITY * self.tilt)
+        self._geometry = [(tuple(self.mix[i]), (float(self.rotors[i, 0]), float(self.rotors[i, 1])),
+                           float(self.spin[i])) for i in range(ROTORS)]
+        self.rotor_speed = [hover] * ROTORS
+
+    def state(self) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """Position, rotation matrix (body to world), velocity, body angular rate."""
+        pos, quat = self.client.call("getBasePositionAndOrientation", self.body)
+        lin, ang = self.client.call("getBaseVelocity", self.body)
+        rot = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
+        return np.array(pos), rot, np.array(lin), rot.T @ np.array(ang)
+
+    def position(self) -> FloatArray:
+        pos, _ = self.client.call("getBasePositionAndOrientation", self.body)
+        return np.array(pos)
+
+    def control(self, p_ref: Vec, v_ref: Vec, yaw_ref: float = 0.0) -> None:
+        """One controller update; the rotor forces hold until the next one.
+
+        Written on plain floats: for 3-vectors, numpy's call overhead costs more than the
+        arithmetic (``np.cross`` alone takes 20 us).
+        """
+        spec, cid, body = self.spec, self.client.id, self.body
+        (px, py, pz), quat = pb.getBasePositionAndOrientation(body, physicsClientId=cid)
+        (vx, vy, vz), (wx, wy, wz) = pb.getBaseVelocity(body, physicsClientId=cid)
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = pb.getMatrixFromQuaternion(quat)
+        # position -> velocity -> acceleration, with speed, tilt and climb limits
+        dx = v_ref[0] + KP_POS * (p_ref[0] - px)
+        dy = v_ref[1] + KP_POS * (p_ref[1] - py)
+        dz = v_ref[2] + KP_POS * (p_ref[2] - pz)
+        speed = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if speed > self.max_speed:
+            k = self.max_speed / speed
+            dx, dy, dz = dx * k, dy * k, dz * k
+        ax, ay, az = KV * (dx - vx), KV * (dy - vy), KV * (dz - vz)
+        horizontal = math.hypot(ax, ay)
+        if horizontal > self.max_horizontal:
+            k = self.max_horizontal / horizontal
+            ax, ay = ax * k, ay * k
+        az = min(max(az, -0.5 * GRAVITY), 0.5 * GRAVITY)
+        fx, fy, fz = spec.mass * ax, spec.mass * ay, spec.mass * (az + GRAVITY)
+        thrust = max(fx * r02 + fy * r12 + fz * r22, 0.0)
+        norm = math.sqrt(fx * fx + fy * fy + fz * fz)
+        zx, zy, zz = fx / norm, fy / norm, fz / norm
+        # desired attitude: body z along the force, heading yaw_ref
+        cx, cy = math.cos(yaw_ref), math.sin(yaw_ref)
+        yx, yy, yz = -zz * cy, zz * cx, zx * cy - zy * cx  # z_d x (cos, sin, 0)
+        norm = math.sqrt(yx * yx + yy * yy + yz * yz)
+        yx, yy, yz = yx / norm, yy / norm, yz / norm
+        xx, xy, xz = yy * zz - yz * zy, yz * zx - yx * zz, yx * zy - yy * zx
+        # attitude error e = vee(Rd^T R - R^T Rd) / 2, from the columns of both matrices
+        e0 = 0.5 * ((zx * r01 + zy * r11 + zz * r21) - (yx * r02 + yy * r12 + yz * r22))
+        e1 = 0.5 * ((xx * r02 + xy * r12 + xz * r22) - (zx * r00 + zy * r10 + zz * r20))
+        e2 = 0.5 * ((yx * r00 + yy * r10 + yz * r20) - (xx * r01 + xy * r11 + xz * r21))
+        # body rates and torques
+        bx = r00 * wx + r10 * wy + r20 * wz
+        by = r01 * wx + r11 * wy + r21 * wz
+        bz = r02 * wx + r12 * wy + r22 * wz
+        jx, jy, jz = spec.inertia
+        tx = jx * K_RATE[0] * (-K_ATT[0] * e0 - bx) + (by * jz * bz - bz * jy * by)
+        ty = jy * K_RATE[1] * (-K_ATT[1] * e1 - by) + (bz * jx * bx - bx * jz * bz)
+        tz = jz * K_RATE[2] * (-K_ATT[2] * e2 - bz) + (bx * jy * by - by * jx * bx)
+        self._rotors((thrust, tx, ty, tz), (px, py, pz),
+                     (r00, r01, r02, r10, r11, r12, r20, r21, r22))
+
+    def _rotors(self, wrench: tuple[float, float, float, float], pos: Vec,
+                rot: tuple[float, ...]) -> None:
+        """Mix (thrust, torques) to rotor thrusts through the motors' lag; apply them."""
+        kf, km, cid, body = self.spec.thrust_constant, self.spec.moment_constant, \
+            self.client.id, self.body
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = rot
+        ux, uy, uz = r02, r12, r22
+        drag = 0.0
+        for i, (mix, (ox, oy), spin) in enumerate(self._geometry):
+            wanted = min(max(mix[0] * wrench[0] + mix[1] * wrench[1] + mix[2] * wrench[2]
+                             + mix[3] * wrench[3], 0.0), self.max_thrust)
+            speed = self.rotor_speed[i]
+            speed += (math.sqrt(wanted / kf) - speed) * self.motor_alpha
+            self.rotor_speed[i] = speed
+            f = kf * speed * speed
+            drag += spin * f
+            where = (pos[0] + r00 * ox + r01 * oy, pos[1] + r10 * ox + r11 * oy,
+                     pos[2] + r20 * ox + r21 * oy)
+            pb.applyExternalForce(body, -1, (ux * f, uy * f, uz * f), where, pb.WORLD_FRAME,
+                                  physicsClientId=cid)
+        drag *= km
+        pb.applyExternalTorque(body, -1, (ux * drag, uy * drag, uz * drag), pb.WORLD_FRAME,
+                               physicsClientId=cid)

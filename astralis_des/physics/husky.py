@@ -1,0 +1,102 @@
+"""The Husky UGV from ``pybullet_data``, driven only through its four wheel joints.
+
+Loaded with implicit cylinders for its wheels (the URDF's own cylinders, not tessellated) and
+its fixed links merged: the same robot, at half the contact cost. A pure-pursuit follower
+turns the path into a speed and a curvature, and those into wheel speeds (skid steering).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pybullet as pb
+
+from astralis_des.physics.client import PhysicsClient, quiet_c_output
+from astralis_des.world.geometry import FloatArray
+
+WHEEL_RADIUS = 0.17775
+TRACK = 0.5709  # m between left and right wheels
+SKID = 3.5  # skid-steered: the effective track is wider than the geometric one (measured)
+WHEEL_TORQUE = 120.0  # N m per wheel
+LOOKAHEAD = 0.8  # m
+ARRIVED = 0.2  # m from the end of the path
+NEAR = 0.3  # m: a goal this close beside the robot counts as reached
+MAX_TURN_RATE = 1.2  # rad/s
+DECEL = 1.0  # m/s^2
+
+
+class Husky:
+    def __init__(self, client: PhysicsClient, start: FloatArray) -> None:
+        self.client = client
+        with quiet_c_output():
+            self.body = int(client.call(
+                "loadURDF", "husky/husky.urdf", [float(start[0]), float(start[1]),
+                                                 float(start[2]) + 0.02],
+                flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_MERGE_FIXED_LINKS))
+        names = {client.call("getJointInfo", self.body, j)[1].decode(): j
+                 for j in range(client.call("getNumJoints", self.body))}
+        self.left = [names["front_left_wheel"], names["rear_left_wheel"]]
+        self.right = [names["front_right_wheel"], names["rear_right_wheel"]]
+        self.wheels = self.left + self.right
+        self.path: FloatArray = np.zeros((0, 3))
+        self.index = 0
+        self.speed = 1.0
+        self.drive(0.0, 0.0)
+
+    def pose(self) -> tuple[float, float, float, float]:
+        """x, y, z of the base, and heading."""
+        (x, y, z), quat = pb.getBasePositionAndOrientation(self.body,
+                                                           physicsClientId=self.client.id)
+        yaw = pb.getEulerFromQuaternion(quat)[2]
+        return x, y, z, yaw
+
+    def position(self) -> FloatArray:
+        x, y, z, _ = self.pose()
+        return np.array([x, y, z])
+
+    def velocity_in_body(self) -> tuple[float, float]:
+        """Forward and lateral speed, m/s: a non-holonomic robot keeps the second near 0."""
+        (vx, vy, _), _ = pb.getBaseVelocity(self.body, physicsClientId=self.client.id)
+        yaw = self.pose()[3]
+        return vx * math.cos(yaw) + vy * math.sin(yaw), -vx * math.sin(yaw) + vy * math.cos(yaw)
+
+    def drive(self, speed: float, turn_rate: float) -> None:
+        """Wheel speeds for a forward speed (m/s) and a turn rate (rad/s)."""
+        half = turn_rate * TRACK * SKID / 2
+        left, right = (speed - half) / WHEEL_RADIUS, (speed + half) / WHEEL_RADIUS
+        pb.setJointMotorControlArray(self.body, self.wheels, pb.VELOCITY_CONTROL,
+                                     targetVelocities=[left, left, right, right],
+                                     forces=[WHEEL_TORQUE] * 4, physicsClientId=self.client.id)
+
+    def follow(self, path: FloatArray, speed: float) -> None:
+        self.path = np.asarray(path, dtype=float)
+        self.index = 0
+        self.speed = speed
+
+    def track(self) -> bool:
+        """One pure-pursuit update; true once the end of the path is reached."""
+        x, y, _, yaw = self.pose()
+        path = self.path
+        end = path[-1]
+        remaining = math.hypot(end[0] - x, end[1] - y)
+        beside = remaining < NEAR and abs(math.cos(math.atan2(end[1] - y, end[0] - x) - yaw)) < 0.5
+        if remaining < ARRIVED or beside:  # at the goal, or next to it: no turning on the spot
+            self.drive(0.0, 0.0)
+            return True
+        # advance along the path to the first point a lookahead away (never back)
+        while self.index < len(path) - 1 and math.hypot(
+                path[self.index][0] - x, path[self.index][1] - y) < LOOKAHEAD:
+            self.index += 1
+        gx, gy = path[self.index][0], path[self.index][1]
+        alpha = math.atan2(gy - y, gx - x) - yaw
+        alpha = math.atan2(math.sin(alpha), math.cos(alpha))
+        if abs(alpha) > math.pi / 3:  # face the path first: turn on the spot
+            self.drive(0.0, math.copysign(MAX_TURN_RATE, alpha))
+            return False
+        distance = max(math.hypot(gx - x, gy - y), 1e-3)
+        braking = math.sqrt(2.0 * DECEL * remaining)  # stop at the end, not before it
+        speed = min(self.speed, braking) * max(math.cos(alpha), 0.2)
+        turn = max(-MAX_TURN_RATE, min(MAX_TURN_RATE, 2.0 * speed * math.sin(alpha) / distance))
+        self.drive(speed, turn)
+        return False
