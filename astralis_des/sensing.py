@@ -35,7 +35,7 @@ class GeometricSensor:
 
     def first_sighting(self, robot: Robot, motion: Motion) -> Sighting | None:
         pts, s = resample(motion.points, SAMPLE_STEP)
-        return self._first(robot, pts, s / motion.speed)
+        return self._first(robot, pts, motion.time_of(s))
 
     def sighting_from(self, robot: Robot, position: FloatArray) -> Sighting | None:
         return self._first(robot, np.asarray(position, dtype=float)[None, :], np.zeros(1))

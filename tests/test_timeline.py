@@ -17,9 +17,26 @@ import pytest
 
 from astralis_des import InputError, Mission, RunResult, Simulation, load_mission
 from astralis_des.assignment import table4_action
+from astralis_des.kernel.robot import Motion
 from astralis_des.kinds import KIND_DEFAULTS
 
-UAV_SPEED = KIND_DEFAULTS["uav"].speed
+UAV = KIND_DEFAULTS["uav"]
+
+
+def flown_in(result: RunResult, robot: str, seconds: float) -> float:
+    """How far the robot's first route takes it in ``seconds``, under its speed profile."""
+    start = next(e for e in result.events if e["kind"] == "task_started" and e["robot"] == robot)
+    assert start["t"] == 0.0
+    sim = Simulation(load_mission(MISSION))
+    here = sim.robots[robot]
+    points = route_to(sim, here, start["room"])
+    return Motion(points, UAV.speed, accel=UAV.accel).travelled(seconds)
+
+
+def route_to(sim: Simulation, robot: Any, room: str) -> Any:
+    from astralis_des.actions.common import route
+
+    return route(sim, robot, sim.world.rooms[room].door_point("corridor"))
 MISSION = Path(__file__).resolve().parents[1] / "missions" / "urban_search.yaml"
 
 
@@ -73,12 +90,12 @@ def test_fault_fails_the_running_task(mission: Mission) -> None:
     assert (move["robot"], move["action"], move["t"]) == ("uav1", "move", 10.0)
     assert move["status"] == "failed"
     assert move["message"] == "robot fault: rotor"
-    assert move["distance"] == pytest.approx(10.0 * UAV_SPEED)  # at cruise speed for 10 s
+    assert move["distance"] == pytest.approx(flown_in(result, "uav1", 10.0))
     spiral = finished(result, 2)
     assert (spiral["action"], spiral["t"], spiral["status"]) == ("spiral_inward", 10.0,
                                                                  "cancelled")
     assert result.robots["uav1"].faulted is True
-    assert result.robots["uav1"].distance == pytest.approx(10.0 * UAV_SPEED)
+    assert result.robots["uav1"].distance == pytest.approx(move["distance"])
 
 
 def test_faulted_robot_takes_no_later_round(mission: Mission) -> None:
@@ -176,7 +193,7 @@ def test_command_with_preempt(mission: Mission) -> None:
                                      "preempt": True}])
     move = finished(result, 3)
     assert (move["action"], move["t"], move["status"]) == ("move", 10.0, "preempted")
-    assert move["distance"] == pytest.approx(10.0 * UAV_SPEED)
+    assert move["distance"] == pytest.approx(flown_in(result, "uav2", 10.0))
     order = [(e["kind"], e["task"], e["t"]) for e in result.events
              if e.get("robot") == "uav2" and e["kind"] in ("task_started", "task_finished")]
     hover = next(e["task"] for e in events(result, "task_queued", "uav2")

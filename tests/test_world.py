@@ -83,4 +83,4 @@ def test_points_inside_walls_or_outside_the_site_are_refused(world: World) -> No
     with pytest.raises(InputError, match="outside the world"):
         world.router.place_of((-5.0, 10.0, 0.0))
     with pytest.raises(InputError, match="inside a building or obstacle"):
-        world.router.place_of((60.0, 72.0, 1.0))
+        world.router.place_of((78.0, 84.0, 1.0))  # the closed space beside the lobby

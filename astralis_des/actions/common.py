@@ -63,7 +63,8 @@ def at_height(robot: Robot, floor_points: FloatArray) -> FloatArray:
 def route(ctx: Context, robot: Robot,
           goal_floor: FloatArray | tuple[float, ...]) -> FloatArray | None:
     """Route from where the robot is to a floor-level goal, at the robot's sensor height."""
-    here = robot.position(ctx.env.now) - np.array([0.0, 0.0, robot.height])
+    here = robot.position(ctx.env.now).copy()
+    here[2] = ctx.world.floor_below(here)  # where it stands, or the floor it flies over
     pts = ctx.world.router.route(here, goal_floor, robot.kind)
     return None if pts is None else at_height(robot, pts)
 
@@ -71,7 +72,8 @@ def route(ctx: Context, robot: Robot,
 def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> StepGen:
     """Follow ``points``; when sensing, report the target the moment it comes into view."""
     before = robot.distance
-    motion = Motion(points, robot.speed, turn_rate=robot.turn_rate, heading=robot.heading)
+    motion = Motion(points, robot.speed, accel=robot.accel, turn_rate=robot.turn_rate,
+                    heading=robot.heading)
     done = ctx.cosim.execute(robot, motion)
     if sense:
         seen = ctx.cosim.watch(robot, motion, ctx.sensor, done)

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from astralis_des.kernel.profile import Profile, build
 from astralis_des.world.geometry import FloatArray
 
 if TYPE_CHECKING:
@@ -16,49 +16,26 @@ if TYPE_CHECKING:
 
 @dataclass
 class Motion:
-    """A path followed at constant speed from ``t0``; the pose is interpolated on demand.
-
-    With a ``turn_rate`` (a non-holonomic robot) it first turns on the spot at each vertex,
-    from ``heading`` to the direction of the next leg.
-    """
+    """A path followed from ``t0`` under a speed profile (:mod:`.profile`): cruise at
+    ``speed``; with ``accel``, speed up, slow down at corners and stop at the end; with
+    ``turn_rate``, turn on the spot from ``heading`` at each vertex. Poses are interpolated
+    on demand."""
 
     points: FloatArray
     speed: float
     t0: float = 0.0
+    accel: float | None = None
     turn_rate: float | None = None
     heading: float = 0.0
     cum: FloatArray = field(init=False)
-    knots: FloatArray = field(init=False)  # time since t0 of each entry of ``stops``
-    stops: FloatArray = field(init=False)  # vertices, repeated where the robot turns
-    stop_cum: FloatArray = field(init=False)
+    profile: Profile = field(init=False)
 
     def __post_init__(self) -> None:
         self.points = np.asarray(self.points, dtype=float)
         seg = np.linalg.norm(np.diff(self.points, axis=0), axis=1) if len(self.points) > 1 \
             else np.zeros(0)
         self.cum = np.concatenate([[0.0], np.cumsum(seg)])
-        legs = seg / self.speed
-        if self.turn_rate is None:
-            self.knots = np.concatenate([[0.0], np.cumsum(legs)])
-            self.stops, self.stop_cum = self.points, self.cum
-            return
-        heading, t = self.heading, 0.0
-        knots, stops, cums = [0.0], [self.points[0]], [0.0]
-        for i, length in enumerate(seg):
-            d = self.points[i + 1] - self.points[i]
-            if length > 1e-6 and math.hypot(d[0], d[1]) > 1e-6:
-                want = math.atan2(d[1], d[0])
-                t += abs(math.remainder(want - heading, math.tau)) / self.turn_rate
-                heading = want
-                knots.append(t)
-                stops.append(self.points[i])
-                cums.append(self.cum[i])
-            t += legs[i]
-            knots.append(t)
-            stops.append(self.points[i + 1])
-            cums.append(self.cum[i + 1])
-        self.end_heading = heading
-        self.knots, self.stops, self.stop_cum = np.array(knots), np.array(stops), np.array(cums)
+        self.profile = build(self.points, self.speed, self.accel, self.turn_rate, self.heading)
 
     @property
     def length(self) -> float:
@@ -66,36 +43,57 @@ class Motion:
 
     @property
     def duration(self) -> float:
-        return float(self.knots[-1])
+        return self.profile.duration
+
+    def _point(self, s: float) -> FloatArray:
+        return np.array([np.interp(s, self.cum, self.points[:, k]) for k in range(3)])
 
     def at(self, t: float) -> FloatArray:
-        dt = t - self.t0
-        return np.array([np.interp(dt, self.knots, self.stops[:, k]) for k in range(3)])
+        return self._point(float(self.profile.arc(t - self.t0)))
+
+    def velocity(self, t: float) -> FloatArray:
+        """The reference velocity at ``t``: the profile's speed along the current leg."""
+        s = float(self.profile.arc(t - self.t0))
+        k = min(max(int(np.searchsorted(self.cum, s, side="right")), 1), len(self.cum) - 1)
+        leg = self.points[k] - self.points[k - 1]
+        norm = float(np.linalg.norm(leg))
+        return leg / norm * self.profile.speed(t - self.t0) if norm > 1e-9 else np.zeros(3)
+
+    def sample(self, times: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Reference positions and velocities at many times at once: ``(N, 3)`` each."""
+        dt = np.asarray(times, dtype=float) - self.t0
+        s = self.profile.arc(dt)
+        pos = np.column_stack([np.interp(s, self.cum, self.points[:, k]) for k in range(3)])
+        legs = np.diff(self.points, axis=0)
+        norms = np.linalg.norm(legs, axis=1)
+        unit = np.divide(legs, norms[:, None], out=np.zeros_like(legs), where=norms[:, None] > 0)
+        k = np.clip(np.searchsorted(self.cum, s, side="right"), 1, len(self.cum) - 1) - 1
+        return pos, unit[k] * self.profile.speeds(dt)[:, None]
 
     def travelled(self, t: float) -> float:
-        return float(np.interp(t - self.t0, self.knots, self.stop_cum))
+        return float(self.profile.arc(t - self.t0))
+
+    def time_of(self, s: FloatArray) -> FloatArray:
+        """Seconds after the start at which each arc length in ``s`` is reached."""
+        return self.profile.time_of(s)
 
     def heading_at(self, t: float, before: float) -> float:
-        """The heading once the motion has run until ``t`` (``before``: at its start)."""
-        if self.turn_rate is None or t - self.t0 < self.duration:
-            return before if self.turn_rate is None else self._heading_before(t - self.t0,
-                                                                              before)
-        return self.end_heading
-
-    def _heading_before(self, dt: float, heading: float) -> float:
-        for i in range(len(self.stops) - 1):
-            if self.knots[i] > dt:
-                break
-            d = self.stops[i + 1] - self.stops[i]
-            if math.hypot(d[0], d[1]) > 1e-6:
-                heading = math.atan2(d[1], d[0])
-        return heading
+        """The heading after running until ``t``: that of the last leg begun."""
+        headings = self.profile.headings
+        if self.turn_rate is None or len(headings) == 0:
+            return before
+        s = float(self.profile.arc(t - self.t0))
+        legs = np.flatnonzero(np.diff(self.cum) > 1e-9)
+        begun = legs[self.cum[legs] <= s + 1e-9]
+        flat = [i for i, leg in enumerate(begun)
+                if np.hypot(*np.diff(self.points[[leg, leg + 1]], axis=0)[0][:2]) > 1e-6]
+        return float(headings[flat[-1]]) if flat else before
 
     def vertices_until(self, t: float) -> tuple[FloatArray, FloatArray]:
         """Timed vertices passed by time ``t``, plus the pose at ``t``: ``(times, points)``."""
-        times = self.t0 + self.knots
+        times = self.t0 + self.profile.time_of(self.cum)
         keep = times < t
-        pts = np.vstack([self.stops[keep], self.at(t)[None, :]])
+        pts = np.vstack([self.points[keep], self.at(t)[None, :]])
         return np.append(times[keep], t), pts
 
 
@@ -110,6 +108,7 @@ class Robot:
     handler: TaskHandler | None = None
     motion: Motion | None = None
     faulted: bool = False
+    accel: float | None = None  # m/s^2; None: starts and stops at once
     turn_rate: float | None = None  # rad/s on the spot, for a non-holonomic robot
     heading: float = 0.0
     distance: float = 0.0

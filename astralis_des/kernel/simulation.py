@@ -69,7 +69,7 @@ class Simulation:
         start = start + np.array([0.0, 0.0, height])
         robot = Robot(member.id, member.kind, member.speed or d.speed,
                       member.detection_radius or d.detection_radius, height, start,
-                      turn_rate=d.turn_rate)
+                      accel=d.accel, turn_rate=d.turn_rate)
         robot.trail_t.append(0.0)
         robot.trail_p.append(start.copy())
 

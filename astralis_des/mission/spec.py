@@ -146,7 +146,7 @@ class HexacopterSpec(Strict):
     max_rotor_speed: PositiveFloat = Field(838.0, description="rad/s")
     motor_time_constant: NonNegativeFloat = 0.0125
     max_tilt_deg: Annotated[float, Field(gt=0, lt=60)] = 25.0
-    max_accel: PositiveFloat = Field(4.5, description="m/s^2, commanded horizontal")
+    max_accel: PositiveFloat = Field(3.5, description="m/s^2, commanded horizontal")
     radius: PositiveFloat = Field(0.3, description="m, collision cylinder (rotor tips)")
 
     @model_validator(mode="after")
@@ -163,7 +163,7 @@ class PhysicsSpec(Strict):
 
     rate: Annotated[int, Field(ge=30, le=2000)] = Field(240, description="physics steps per s")
     control_rate: Annotated[int, Field(ge=10, le=2000)] = Field(
-        120, description="controller updates per s; must divide rate")
+        80, description="controller updates per s; must divide rate")
     log_rate: PositiveFloat = Field(10.0, description="pose samples per s in the recording")
     stuck_timeout: PositiveFloat = Field(15.0, description="s without progress: the action fails")
     solver_iterations: Annotated[int, Field(ge=1, le=200)] = 20

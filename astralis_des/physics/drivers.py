@@ -24,6 +24,7 @@ from astralis_des.registry import Registry
 from astralis_des.world.geometry import FloatArray
 
 ARRIVED = 0.2  # m from the end of its path, nearly still: a UAV has arrived
+UGV_RATE = 40  # Hz: pure pursuit updates (when the control rate is a multiple of it)
 LIFT_RISE = 0.3  # m: a leg climbing more than this is ridden on the stairwell's vehicle lift
 
 
@@ -46,32 +47,32 @@ class UavDriver:
     def __init__(self, client: PhysicsClient, robot: Robot, spec: PhysicsSpec, urdf: Path) -> None:
         self.client = client
         self.spec = spec.uav
-        self.craft = Hexacopter(client, spec.uav, urdf, robot.pose, 1.0 / spec.control_rate)
+        self.period = 1.0 / spec.control_rate
+        self.craft = Hexacopter(client, spec.uav, urdf, robot.pose, self.period)
         self.body = self.craft.body
         self.motion: Motion | None = None
         self.freeze()
 
     def start(self, motion: Motion, t: float) -> None:
+        """Wake the body and sample the whole reference at the control rate, once."""
         self.motion = motion
         self.client.call("changeDynamics", self.body, -1, mass=self.spec.mass,
                          localInertiaDiagonal=list(self.spec.inertia))
         self.client.call("resetBaseVelocity", self.body, [0, 0, 0], [0, 0, 0])
+        ticks = np.arange(math.ceil(motion.duration / self.period) + 1)
+        self.t0 = t
+        self.end = t + motion.duration
+        pos, vel = motion.sample(np.asarray(t + ticks * self.period, dtype=float))
+        self.ref_pos, self.ref_vel = pos.tolist(), vel.tolist()
+        self.goal = pos[-1]
 
     def tick(self, t: float) -> str | None:
-        motion = self.motion
-        assert motion is not None
-        ref = motion.at(t)
-        if t < motion.t0 + motion.duration:
-            s = (t - motion.t0) * motion.speed
-            k = min(int(np.searchsorted(motion.cum, s, side="right")), len(motion.cum) - 1)
-            leg = motion.points[k] - motion.points[k - 1]
-            vel = leg / max(float(np.linalg.norm(leg)), 1e-9) * motion.speed
-        else:
-            vel = np.zeros(3)
+        k = min(round((t - self.t0) / self.period), len(self.ref_pos) - 1)
+        if t >= self.end:
             pos, _, v, _ = self.craft.state()
-            if math.dist(pos, ref) < ARRIVED and math.hypot(*v) < 0.3:
+            if math.dist(pos, self.goal) < ARRIVED and math.hypot(*v) < 0.3:
                 return "arrived"
-        self.craft.control(ref, vel)
+        self.craft.control(self.ref_pos[k], self.ref_vel[k])
         return None
 
     def position(self) -> FloatArray:
@@ -96,6 +97,8 @@ class UgvDriver:
         self.legs: list[tuple[bool, FloatArray]] = []
         self.speed = robot.speed
         self.lift: tuple[float, FloatArray] | None = None
+        self.every = max(1, round(spec.control_rate / UGV_RATE))
+        self._ticks = 0
 
     def start(self, motion: Motion, t: float) -> None:
         floor = motion.points - np.array([0.0, 0.0, self.height])
@@ -123,6 +126,7 @@ class UgvDriver:
         if ride:
             self.lift = (t, points)
         else:
+            self.floor = float(points[-1][2])
             self.husky.follow(points, self.speed)
 
     def tick(self, t: float) -> str | None:
@@ -139,8 +143,10 @@ class UgvDriver:
             if share >= 1.0:
                 self._next_leg(t)
             return None
+        self._ticks += 1
+        if self._ticks % self.every and not self.lift:  # the wheel motors hold their targets
+            return None
         if self.husky.track():
-            self.floor = float(self.husky.path[-1][2])
             if not self.legs:
                 return "arrived"
             self._next_leg(t)

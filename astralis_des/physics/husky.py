@@ -39,8 +39,9 @@ class Husky:
         self.left = [names["front_left_wheel"], names["rear_left_wheel"]]
         self.right = [names["front_right_wheel"], names["rear_right_wheel"]]
         self.wheels = self.left + self.right
-        self.path: FloatArray = np.zeros((0, 3))
-        self.index = 0
+        self.path: FloatArray = np.zeros((0, 2))
+        self.cum: FloatArray = np.zeros(1)
+        self.progress = 0.0
         self.speed = 1.0
         self.drive(0.0, 0.0)
 
@@ -70,25 +71,46 @@ class Husky:
                                      forces=[WHEEL_TORQUE] * 4, physicsClientId=self.client.id)
 
     def follow(self, path: FloatArray, speed: float) -> None:
-        self.path = np.asarray(path, dtype=float)
-        self.index = 0
+        self.path = np.asarray(path, dtype=float)[:, :2]
+        seg = np.linalg.norm(np.diff(self.path, axis=0), axis=1)
+        self.cum = np.concatenate([[0.0], np.cumsum(seg)])
+        self.progress = 0.0  # arc length of the robot's projection on the path, never back
         self.speed = speed
+
+    def _project(self, x: float, y: float) -> float:
+        """Arc length of the closest point of the path ahead of the current progress."""
+        best_s, best_d = self.progress, math.inf
+        first = max(int(np.searchsorted(self.cum, self.progress, side="right")) - 1, 0)
+        for i in range(first, len(self.path) - 1):
+            a, b = self.path[i], self.path[i + 1]
+            length = self.cum[i + 1] - self.cum[i]
+            if length < 1e-9:
+                continue
+            u = min(max(((x - a[0]) * (b[0] - a[0]) + (y - a[1]) * (b[1] - a[1]))
+                        / (length * length), 0.0), 1.0)
+            d = math.hypot(a[0] + u * (b[0] - a[0]) - x, a[1] + u * (b[1] - a[1]) - y)
+            if d < best_d - 1e-9:
+                best_s, best_d = self.cum[i] + u * length, d
+            if self.cum[i] > self.progress + 2 * LOOKAHEAD:
+                break
+        return max(best_s, self.progress)
+
+    def _point_at(self, s: float) -> tuple[float, float]:
+        s = min(s, float(self.cum[-1]))
+        return (float(np.interp(s, self.cum, self.path[:, 0])),
+                float(np.interp(s, self.cum, self.path[:, 1])))
 
     def track(self) -> bool:
         """One pure-pursuit update; true once the end of the path is reached."""
         x, y, _, yaw = self.pose()
-        path = self.path
-        end = path[-1]
+        end = self.path[-1]
         remaining = math.hypot(end[0] - x, end[1] - y)
         beside = remaining < NEAR and abs(math.cos(math.atan2(end[1] - y, end[0] - x) - yaw)) < 0.5
         if remaining < ARRIVED or beside:  # at the goal, or next to it: no turning on the spot
             self.drive(0.0, 0.0)
             return True
-        # advance along the path to the first point a lookahead away (never back)
-        while self.index < len(path) - 1 and math.hypot(
-                path[self.index][0] - x, path[self.index][1] - y) < LOOKAHEAD:
-            self.index += 1
-        gx, gy = path[self.index][0], path[self.index][1]
+        self.progress = self._project(x, y)
+        gx, gy = self._point_at(self.progress + LOOKAHEAD)
         alpha = math.atan2(gy - y, gx - x) - yaw
         alpha = math.atan2(math.sin(alpha), math.cos(alpha))
         if abs(alpha) > math.pi / 3:  # face the path first: turn on the spot

@@ -50,7 +50,7 @@ class Room:
         sx, sy, _ = self.box.size
         return sx * sy
 
-    def door_point(self, side: str = "corridor", offset: float = 0.3) -> tuple[float, float, float]:
+    def door_point(self, side: str = "corridor", offset: float = 0.6) -> tuple[float, float, float]:
         """A point ``offset`` beyond the door's wall, on the room or the corridor side."""
         axis = self.door.normal_axis
         inward = 1.0 if self.box.center[axis] > self.door.center[axis] else -1.0
@@ -119,6 +119,16 @@ class World:
         from astralis_des.world.routing import Router
 
         return Router(self)
+
+    def floor_below(self, point: tuple[float, ...] | FloatArray) -> float:
+        """Height of the floor under ``point``: a storey's level inside a building, else 0."""
+        x, y, z = float(point[0]), float(point[1]), float(point[2])
+        for b in self.buildings.values():
+            lo, hi = b.footprint.lo, b.footprint.hi
+            if lo[0] <= x <= hi[0] and lo[1] <= y <= hi[1]:
+                storey = min(max(int((z + 0.1) // b.floor_height), 0), b.floors - 1)
+                return storey * b.floor_height
+        return 0.0
 
     def contains(self, point: tuple[float, ...] | FloatArray) -> bool:
         x, y = float(point[0]), float(point[1])

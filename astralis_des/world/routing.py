@@ -17,6 +17,8 @@ from astralis_des.world.model import World
 KINDS = ("uav", "ugv", "human")
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
 STAIR_RUN_FACTOR = 2.0  # horizontal run of a flight of stairs per metre of rise
+DOORWAY = 0.6  # m: routes cross a door square to its wall, from this far inside the room
+SNAP = 0.5  # m: a point this close to a room or corridor (in a wall, by a door) belongs to it
 
 
 class Router:
@@ -31,6 +33,8 @@ class Router:
         self.corridor_nodes: dict[str, list[int]] = {}
         self.outdoor_nodes: list[int] = []
         self._footprints = self._outdoor_blockers()
+        self._snap_boxes = [(r.id, r.box) for r in world.rooms.values()] + [
+            (s.id, s.box) for s in world.spaces.values()]
         self._build()
         self.positions = np.array(self._pos, dtype=float)
         self.dist: dict[str, FloatArray] = {}
@@ -72,8 +76,10 @@ class Router:
             self.corridor_nodes[corr.id] = nodes
             for room in rooms:
                 door = self._node(f"{room.id}:door", room.door.center)
+                inside = self._node(f"{room.id}:inside", room.door_point("room", DOORWAY))
                 centre = self._node(room.id, room.center)
-                self._edge(centre, door)
+                self._edge(centre, inside)
+                self._edge(inside, door)  # through the doorway square to the wall
                 self._edge(door, nodes[xs.index(room.door.center[0])])
         for b in w.buildings.values():
             stair = w.spaces[f"{b.id}.stairwell"].box
@@ -141,6 +147,9 @@ class Router:
         for space in self.world.spaces.values():
             if space.box.contains(p, margin=0.05):
                 return space.id
+        near = self._nearest_space(p)
+        if near is not None:  # in a wall's thickness, by a doorway: a body's centre can be
+            return near
         where = "[" + ", ".join(f"{v:g}" for v in np.round(p, 2)) + "]"
         if not self.world.contains(p):
             raise InputError(f"point {where} is outside the world")
@@ -148,9 +157,21 @@ class Router:
             raise InputError(f"point {where} is inside a building or obstacle")
         return "outdoor"
 
+    def _nearest_space(self, p: FloatArray) -> str | None:
+        """The room or space within ``SNAP`` of ``p`` (horizontally, on its level), if any."""
+        best, best_d = None, SNAP
+        for name, box in self._snap_boxes:
+            gap = np.maximum(np.maximum(np.array(box.lo) - p, p - np.array(box.hi)), 0.0)
+            if gap[2] > SNAP:
+                continue
+            d = float(np.linalg.norm(gap))
+            if d < best_d:
+                best, best_d = name, d
+        return best
+
     def _entries(self, p: FloatArray, place: str) -> list[int]:
         if place in self.world.rooms:
-            return [self.index[place], self.index[f"{place}:door"]]
+            return [self.index[place], self.index[f"{place}:inside"]]
         if place in self.corridor_nodes:
             return self.corridor_nodes[place]
         if place.endswith(".stairwell"):
