@@ -33,6 +33,8 @@ def search(sim: Simulation) -> Generator[simpy.Event, Any, str]:
     """
     attempts: Counter[str] = Counter()
     max_attempts = sim.mission.spec.assignment.max_attempts
+    if sim.mission.spec.assignment.start_at > 0:
+        yield sim.env.timeout(sim.mission.spec.assignment.start_at)
     for segment in sim.mission.searched_segments():
         pending = list(sim.world.segments[segment].rooms)
         while pending:

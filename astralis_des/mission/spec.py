@@ -89,6 +89,7 @@ class AssignmentSpec(Strict):
         default_factory=lambda: ["A"], min_length=1,
         description="buildings or segment ids to search, in order; each round takes one segment")
     max_attempts: int = Field(2, ge=1, description="rounds a room may be tried in")
+    start_at: NonNegativeFloat = Field(0.0, description="s the team waits before round 1")
 
 
 class _At(Strict):

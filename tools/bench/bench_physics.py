@@ -1,0 +1,95 @@
+"""Physics fidelity benchmark: real-time factor, overhead over raw PyBullet, idle cost.
+
+    python tools/bench/bench_physics.py [--mission missions/urban_search.yaml]
+
+Measured in one run, on this machine:
+- raw PyBullet: the same world (static compound), the Husky and two rigid UAV bodies, stepped
+  at 240 Hz with the Husky driving and the UAVs held up, no Python around it;
+- the default mission in physics at 240 Hz with recording on: wall time, time inside
+  ``stepSimulation``, their ratio (the overhead ratio), the real-time factor;
+- the recording's share (the same run without outputs);
+- the same mission after a one-hour idle wait (``assignment.start_at: 3600``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+
+from astralis_des import Simulation, load_mission  # noqa: E402
+from astralis_des.physics.client import PhysicsClient  # noqa: E402
+from astralis_des.physics.husky import Husky  # noqa: E402
+
+
+def raw_pybullet(mission, steps: int = 2400) -> float:  # type: ignore[no-untyped-def]
+    """Seconds per physics step of bare PyBullet with the mission's bodies, at 240 Hz."""
+    client = PhysicsClient(mission.world, 1 / 240, 1, mission.spec.physics.solver_iterations)
+    husky = Husky(client, np.array([90.0, 60.0, 0.0]))
+    shape = client.call("createCollisionShape", 4, radius=0.3, height=0.12)
+    uavs = [client.call("createMultiBody", 1.5, shape, basePosition=[88.0 + 2 * k, 64.0, 1.5])
+            for k in range(2)]
+    client.step(60)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        husky.drive(1.0, 0.3)
+        for uav in uavs:
+            client.call("applyExternalForce", uav, -1, [0, 0, 1.5 * 9.81], [0, 0, 0], 1)
+        client.step()
+    per_step = (time.perf_counter() - t0) / steps
+    client.close()
+    return per_step
+
+
+def run(mission, out: Path | None):  # type: ignore[no-untyped-def]
+    t0 = time.perf_counter()
+    sim = Simulation(mission, out_dir=out)
+    result = sim.run()
+    return time.perf_counter() - t0, result, sim.cosim.step_time, sim.cosim.client.steps
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--mission", default=str(ROOT / "missions" / "urban_search.yaml"))
+    parser.add_argument("--repeat", type=int, default=3)
+    args = parser.parse_args()
+    mission = load_mission(args.mission).with_changes(fidelity="physics")
+    raw = raw_pybullet(mission)
+    print(f"raw PyBullet (Husky + 2 UAV bodies + world, 240 Hz): {raw * 1e6:.0f} us/step, "
+          f"{1 / 240 / raw:.1f}x real time")
+    runs = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for i in range(args.repeat):
+            runs.append(run(mission, Path(tmp) / str(i)))
+        rrd = Path(tmp) / "0" / "recording.rrd"
+        size = rrd.stat().st_size
+    wall, result, stepping, steps = sorted(runs, key=lambda r: r[0])[len(runs) // 2]
+    bare = statistics.median(run(mission, None)[0] for _ in range(args.repeat))
+    print(f"default mission, physics, recording on ({result.end_time:.1f} s simulated, "
+          f"outcome {result.outcome}):")
+    print(f"  wall {wall:.2f} s, real-time factor {result.end_time / wall:.1f}x (goal >= 30x)")
+    print(f"  inside stepSimulation {stepping:.2f} s: overhead ratio {wall / stepping:.2f} "
+          f"(goal <= 1.5)")
+    print(f"  physics steps taken: {steps} for {result.end_time * 240:.0f} at 240 Hz "
+          f"({steps / (result.end_time * 240):.0%}; nothing is stepped while nothing moves), "
+          f"{stepping / steps * 1e6:.0f} us each")
+    print(f"  recording: {(wall - bare) / wall:.1%} of the run (goal < 10%), {size / 1024:.0f} KiB,"
+          f" {size / 1024 / (result.end_time / 60):.0f} KiB per simulated minute")
+    waited = mission.with_changes(assignment={**mission.spec.assignment.model_dump(),
+                                              "start_at": 3600.0},
+                                  time_limit=mission.spec.time_limit + 3600.0)
+    idle = statistics.median(run(waited, None)[0] for _ in range(args.repeat))
+    print(f"  the same after a one-hour idle wait: {idle:.2f} s against {bare:.2f} s "
+          f"({(idle - bare) / bare:+.1%}; goal < +5%)")
+
+
+if __name__ == "__main__":
+    main()
