@@ -55,6 +55,11 @@ class Simulation:
         self._ids = itertools.count(1)
         self._started: dict[str, tuple[int, float]] = {}  # robot -> running task, its start
         self._handlers: dict[str, TaskHandler] = {}
+        self._end: simpy.Event | None = None
+        self._timeline: simpy.Process | None = None
+        self._limit: simpy.Event | None = None
+        self._sinks: Any = None
+        self._wall0 = time.perf_counter()
         self.robots = {m.id: self._make_robot(m) for m in spec.team}
         self.cosim = load_fidelity(spec.fidelity)(self)
 
@@ -167,40 +172,65 @@ class Simulation:
     # -- running ---------------------------------------------------------------------------
     def run(self) -> RunResult:
         """Run until the target is found, the rooms run out or the time limit; then write."""
+        self.start()
+        try:
+            self.advance()
+        finally:
+            result = self.finish()
+        return result
+
+    def start(self) -> None:
+        """Open the outputs and start the timeline; ``advance`` then moves time on."""
         from astralis_des.sinks import open_sinks
 
+        if self._end is not None:
+            return
         spec = self.mission.spec
-        wall0 = time.perf_counter()
-        sinks = open_sinks(self, self.out_dir)
+        self._wall0 = time.perf_counter()
+        self._sinks = open_sinks(self, self.out_dir)
         if self._progress is not None:
             progress = self._progress
             self.log.sinks.append(lambda rec: progress(rec["t"], spec.time_limit))
         self.log.emit("mission_start", mission=spec.name, seed=spec.seed,
                       fidelity=spec.fidelity, target_room=self.target.room,
                       team=[m.id for m in spec.team])
-        timeline = self.env.process(search(self))
+        self._timeline = self.env.process(search(self))
         for event in spec.timeline:
             self.env.process(scheduled(self, event))
-        limit = self.env.timeout(spec.time_limit)
-        outcome = "interrupted"
-        try:
-            self.env.run(until=simpy.AnyOf(self.env, [self.found, timeline, limit]))
-            if self.found.triggered:
-                outcome = "found"
-            elif timeline.triggered:
-                outcome = str(timeline.value)
-            else:
-                outcome = "time_limit"
-        finally:
-            for robot in self.robots.values():
-                self.cosim.halt(robot)
-                if robot.id in self._started:  # still at work when the mission ended
-                    robot.busy_time += self.env.now - self._started.pop(robot.id)[1]
-            self.cosim.close()
-            self.log.emit("mission_end", outcome=outcome)
-            result = build_result(self, outcome, time.perf_counter() - wall0)
-            sinks.close(result)
-        log.info("%s: %s at t=%.1f s", spec.name, outcome, self.env.now)
+        self._limit = self.env.timeout(spec.time_limit)
+        self._end = simpy.AnyOf(self.env, [self.found, self._timeline, self._limit])
+        # The end stops env.run() itself: wrapping it in another condition would not do, as a
+        # SimPy condition that fires strips the checks of the conditions nested in it.
+        self._end.callbacks.append(simpy.core.StopSimulation.callback)
+
+    def advance(self, until: float | None = None) -> bool:
+        """Run to simulated time ``until`` (or the end); true once the mission has ended."""
+        self.start()
+        assert self._end is not None
+        if not self._end.triggered and (until is None or until > self.env.now):
+            self.env.run(until=until)
+        return self._end.triggered
+
+    def finish(self) -> RunResult:
+        """End the run where it is: halt the robots, close the outputs, return the result."""
+        if self.found.triggered:
+            outcome = "found"
+        elif self._timeline is not None and self._timeline.triggered:
+            outcome = str(self._timeline.value)
+        elif self._limit is not None and self._limit.triggered:
+            outcome = "time_limit"
+        else:
+            outcome = "interrupted"
+        for robot in self.robots.values():
+            self.cosim.halt(robot)
+            if robot.id in self._started:  # still at work when the mission ended
+                robot.busy_time += self.env.now - self._started.pop(robot.id)[1]
+        self.cosim.close()
+        self.log.emit("mission_end", outcome=outcome)
+        result = build_result(self, outcome, time.perf_counter() - self._wall0)
+        if self._sinks is not None:
+            self._sinks.close(result)
+        log.info("%s: %s at t=%.1f s", self.mission.spec.name, outcome, self.env.now)
         return result
 
 

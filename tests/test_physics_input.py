@@ -1,0 +1,49 @@
+"""Physics parameters out of range are refused at validation, naming the key."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from astralis_des.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def mission_with(tmp_path: Path, physics: str) -> Path:
+    text = (ROOT / "missions" / "fig7.yaml").read_text(encoding="utf-8")
+    text = text.replace("world: ../worlds/urban_default.yaml",
+                        f"world: {ROOT / 'worlds' / 'urban_default.yaml'}")
+    path = tmp_path / "mission.yaml"
+    path.write_text(text + "fidelity: physics\nphysics:\n" + physics, encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize(("physics", "key", "says"), [
+    ("  uav: {mass: -1.5}\n", "physics.uav.mass", "greater than 0"),
+    ("  rate: 240\n  control_rate: 100\n", "physics", "does not divide the physics rate"),
+    ("  rate: 240\n  control_rate: 480\n", "physics", "controller period is shorter than dt"),
+    ("  rate: 0\n", "physics.rate", "greater than or equal to 30"),
+    ("  uav: {max_rotor_speed: 300}\n", "physics.uav", "not enough for 1.5 kg"),
+    ("  stuck_timeout: -2\n", "physics.stuck_timeout", "greater than 0"),
+    ("  uav: {mas: 2}\n", "physics.uav", "did you mean 'mass'"),
+])
+def test_bad_physics_parameters_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                            physics: str, key: str, says: str) -> None:
+    """One line naming the key, exit 2, nothing written."""
+    path = mission_with(tmp_path, physics)
+    code = main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert len(err.splitlines()) == 1
+    assert f": {key}" in err and says in err, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_good_physics_section_validates(tmp_path: Path,
+                                          capsys: pytest.CaptureFixture[str]) -> None:
+    """The defaults written out explicitly are accepted."""
+    path = mission_with(tmp_path, "  rate: 240\n  control_rate: 80\n  log_rate: 10\n")
+    assert main(["validate", str(path)]) == 0
+    assert capsys.readouterr().out.startswith("ok: ")
