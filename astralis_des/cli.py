@@ -39,6 +39,8 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--out", help="output folder (default: the mission's outputs.dir, "
                      "else out/<mission name>)")
     run.add_argument("--seed", type=int, help="override the mission's seed")
+    run.add_argument("--fidelity", choices=["kinematic", "physics"],
+                     help="override the mission's fidelity")
     run.add_argument("--no-recording", action="store_true", help="skip the Rerun recording")
     run.add_argument("--quiet", action="store_true", help="no progress bar or summary table")
     val = sub.add_parser("validate", help="check a mission file without running it")
@@ -103,6 +105,8 @@ def _run(args: argparse.Namespace) -> int:
     mission = load_mission(args.mission)
     if args.seed is not None:
         mission = mission.with_changes(seed=args.seed)
+    if args.fidelity is not None:
+        mission = mission.with_changes(fidelity=args.fidelity)
     if args.no_recording:
         outputs = mission.spec.outputs.model_copy(update={"recording": False})
         mission = mission.with_changes(outputs=outputs.model_dump())

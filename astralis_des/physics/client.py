@@ -3,35 +3,19 @@
 from __future__ import annotations
 
 import contextlib
-import os
 import time
-from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 import pybullet as pb
 import pybullet_data
 
+from astralis_des.physics.quiet import quiet_c_output
 from astralis_des.world.model import World
 
+__all__ = ["GRAVITY", "PhysicsClient", "quiet_c_output"]
+
 GRAVITY = 9.81
-
-
-@contextlib.contextmanager
-def quiet_c_output() -> Iterator[None]:
-    """Silence what the C library prints on stdout (URDF importer warnings)."""
-    try:
-        fd = os.dup(1)
-    except OSError:  # no stdout to silence
-        yield
-        return
-    with open(os.devnull, "w") as devnull:
-        os.dup2(devnull.fileno(), 1)
-        try:
-            yield
-        finally:
-            os.dup2(fd, 1)
-            os.close(fd)
 
 
 class PhysicsClient:
@@ -42,7 +26,8 @@ class PhysicsClient:
     """
 
     def __init__(self, world: World, dt: float, substeps: int, solver_iterations: int) -> None:
-        self.id = pb.connect(pb.DIRECT)
+        with quiet_c_output():  # PyBullet prints its build time on connecting
+            self.id = pb.connect(pb.DIRECT)
         self.dt = dt
         self.substeps = substeps
         self.step_time = 0.0  # seconds of wall time inside stepSimulation
