@@ -211,6 +211,11 @@ class Simulation:
             self.env.run(until=until)
         return self._end.triggered
 
+    @property
+    def outputs_time(self) -> float:
+        """Wall seconds spent writing this run's outputs (event log, summary, recording)."""
+        return self._sinks.seconds if self._sinks is not None else 0.0
+
     def finish(self) -> RunResult:
         """End the run where it is: halt the robots, close the outputs, return the result."""
         if self.found.triggered:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -20,18 +21,24 @@ class Output(Protocol):
 
 
 class Outputs:
-    """The open outputs of one run; each sees every event, then the result."""
+    """The open outputs of one run; each sees every event, then the result. ``seconds`` is
+    the wall time they took, opening included, for benchmarks to report their share."""
 
-    def __init__(self, outputs: list[Output]) -> None:
+    def __init__(self, outputs: list[Output], seconds: float = 0.0) -> None:
         self.outputs = outputs
+        self.seconds = seconds
 
     def on_event(self, record: Record) -> None:
+        t0 = time.perf_counter()
         for out in self.outputs:
             out.on_event(record)
+        self.seconds += time.perf_counter() - t0
 
     def close(self, result: RunResult) -> None:
+        t0 = time.perf_counter()
         for out in self.outputs:
             out.close(result)
+        self.seconds += time.perf_counter() - t0
 
 
 class JsonlWriter:
@@ -72,6 +79,7 @@ def write_atomic(path: Path, text: str) -> None:
 
 def open_sinks(sim: Simulation, out_dir: Path | None) -> Outputs:
     """Open what the mission's ``outputs`` asks for under ``out_dir`` (nothing without one)."""
+    t0 = time.perf_counter()
     outputs: list[Output] = []
     if out_dir is not None:
         cfg = sim.mission.spec.outputs
@@ -84,6 +92,6 @@ def open_sinks(sim: Simulation, out_dir: Path | None) -> Outputs:
             from astralis_des.sinks.recording import RerunRecorder
 
             outputs.append(RerunRecorder(sim, out_dir / "recording.rrd"))
-    sinks = Outputs(outputs)
+    sinks = Outputs(outputs, time.perf_counter() - t0)
     sim.log.sinks.append(sinks.on_event)
     return sinks
