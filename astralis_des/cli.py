@@ -45,6 +45,17 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--quiet", action="store_true", help="no progress bar or summary table")
     val = sub.add_parser("validate", help="check a mission file without running it")
     val.add_argument("mission", help="mission YAML file")
+    world = sub.add_parser("world", help="look at worlds")
+    world_sub = world.add_subparsers(dest="world_command", metavar="WORLD_COMMAND",
+                                     required=True)
+    show = world_sub.add_parser("show", help="write a recording of a world, furnished")
+    show.add_argument("world", help="world YAML file")
+    show.add_argument("--messiness", type=float, nargs="+", default=[0.5],
+                      help="messiness of every room, or values cycled over the rooms in id "
+                           "order (default 0.5)")
+    show.add_argument("--seed", type=int, default=0)
+    show.add_argument("--catalogue", help="clutter catalogue file (default: the packaged one)")
+    show.add_argument("-o", "--output", help="recording to write (default out/world_NAME.rrd)")
     schema = sub.add_parser("schema", help="print the JSON Schema of mission or world files")
     schema.add_argument("--world", action="store_true", help="the world file's schema")
     schema.add_argument("-o", "--output", help="write to this file instead of stdout")
@@ -77,6 +88,20 @@ def _validate(args: argparse.Namespace) -> int:
     mission = load_mission(args.mission)
     print(f"ok: {args.mission}: mission '{mission.name}', {len(mission.spec.team)} agents, "
           f"{len(mission.searched_rooms())} rooms to search in world '{mission.world.name}'")
+    return 0
+
+
+@command("world")
+def _world(args: argparse.Namespace) -> int:
+    from astralis_des.world.show import show_world
+
+    out = args.output or str(Path("out") / f"world_{Path(args.world).stem}.rrd")
+    shown = show_world(args.world, args.messiness, out, seed=args.seed,
+                       catalogue=args.catalogue)
+    items = ", ".join(f"{n} {kind}" for kind, n in sorted(shown.placed.items())) or "nothing"
+    print(f"{shown.path}: {shown.rooms} rooms furnished: {items}")
+    for room, kind, reason in shown.skipped:
+        print(f"  not placed in {room}: {kind} ({reason})")
     return 0
 
 

@@ -8,11 +8,20 @@ import pytest
 from astralis_des.actions import coverage as cov
 from astralis_des.actions.common import footprint_spacing
 from astralis_des.kernel.robot import Motion, Robot
+from astralis_des.kernel.scene import Scene
 from astralis_des.sensing import GeometricSensor
+from astralis_des.world.catalogue import default_catalogue
 from astralis_des.world.geometry import Box
 from astralis_des.world.model import World
 
 ROOM = Box((0.0, 0.0, 0.0), (4.0, 7.0, 3.0))
+
+
+def sensor(world: World, target: tuple[float, float, float] | None = None,
+           room: str = "B.1.1.1", messiness: float = 0.0, seed: int = 0) -> GeometricSensor:
+    """A sensor in ``world`` furnished at ``messiness``, the target in ``room`` (at ``target``)."""
+    scene = Scene(world, dict.fromkeys(world.rooms, messiness), seed, default_catalogue())
+    return GeometricSensor(scene, scene.place_target(room, {"activity": "idle"}, target))
 
 
 def robot(kind: str = "uav", radius: float = 2.0, height: float = 1.5) -> Robot:
@@ -61,7 +70,7 @@ def test_uav_patterns_cover_at_least_90_percent(world: World, pattern: str) -> N
         "sweep_y": lambda: cov.lawnmower(room.box, spacing, 1),
     }[pattern]()
     pts = np.column_stack([plane, np.full(len(plane), room.box.lo[2] + r.height)])
-    share = GeometricSensor(world, np.zeros(3)).coverage(r, pts, room)
+    share = sensor(world).coverage(r, pts, room)
     assert share >= 0.9
 
 
@@ -69,22 +78,22 @@ def test_a_peek_from_the_door_sees_part_of_the_room_only(world: World) -> None:
     """From the corridor side of the door the walls hide the room's near corners."""
     room = world.rooms["A.1.1.1"]
     eye = np.array([room.door_point("corridor", 0.15)]) + [0, 0, 0.5]
-    share = GeometricSensor(world, np.zeros(3)).coverage(robot("ugv", 6.0, 0.5), eye, room)
+    share = sensor(world).coverage(robot("ugv", 6.0, 0.5), eye, room)
     assert 0.4 < share < 0.95
 
 
 def test_the_target_is_seen_through_the_door_not_through_the_wall(world: World) -> None:
     """A target in a room is detected from a path past its door, not from behind its wall."""
     room = world.rooms["A.1.1.2"]
-    target = np.array([room.center[0], room.center[1], room.box.lo[2] + 0.5])
-    sensor = GeometricSensor(world, target)
+    target = (room.center[0], room.center[1], room.box.lo[2] + 0.5)
+    seer = sensor(world, target, room.id)
     r = robot("ugv", 6.0, 0.5)
     corridor_y = room.door_point("corridor", 1.0)[1]
     past_door = Motion(np.array([[62.5, corridor_y, 0.5], [79.0, corridor_y, 0.5]]), 1.0)
-    seen = sensor.first_sighting(r, past_door)
+    seen = seer.first_sighting(r, past_door)
     assert seen is not None
     assert abs(seen.robot_position[0] - room.door.center[0]) < 1.5
     neighbour = world.rooms["A.1.1.1"]
     inside_neighbour = Motion(np.array([neighbour.center, neighbour.door_point("room")]) +
                               [0, 0, 0.5], 1.0)
-    assert sensor.first_sighting(r, inside_neighbour) is None
+    assert seer.first_sighting(r, inside_neighbour) is None

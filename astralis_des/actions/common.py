@@ -90,7 +90,7 @@ def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> Ste
 def dwell(ctx: Context, robot: Robot, seconds: float) -> StepGen:
     """Stay and look around from where the robot is."""
     ctx.cosim.halt(robot)
-    hit = ctx.sensor.sighting_from(robot, robot.position(ctx.env.now))
+    hit = ctx.sensor.sighting_from(robot, robot.position(ctx.env.now), ctx.env.now)
     if hit is not None:
         ctx.report_detection(robot, hit)
     yield ctx.cosim.dwell(robot, seconds)

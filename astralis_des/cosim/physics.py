@@ -84,6 +84,7 @@ class PhysicsCoSim:
             for rid, robot in sim.robots.items()}
         self.names = {d.body: rid for rid, d in self.drivers.items()}
         self.names.update({self.client.static: "wall", self.client.ground: "ground"})
+        self._add_scene(sim)
         self.site = sim.world.site
         self.active: dict[str, tuple[Robot, Track, simpy.Event]] = {}
         self.touching: set[tuple[str, str]] = set()
@@ -92,6 +93,28 @@ class PhysicsCoSim:
         self._next_log = 0.0
         self._ticks = 0
         self.env.process(self._stepper())
+
+    def _add_scene(self, sim: Simulation) -> None:
+        """Furniture and still avatars as one static body; the target; movers kinematic."""
+        scene = sim.scene
+        still = scene.static_bodies(sorted(sim.world.rooms))
+        if still:
+            body = self.client.add_boxes([p.box.lo for p in still], [p.box.hi for p in still])
+            self.names[body] = "furniture"
+        self.movers = [(m, self.client.add_box(m.position_at(0.0), m.size))
+                       for m in [*scene.movers, *scene.avatar_movers()]]
+        self.names.update({body: m.kind for m, body in self.movers})
+        target = sim.target
+        if target.mover is None:
+            w, d = (1.8, 0.6) if target.avatar.get("activity") == "laying" else (0.5, 0.5)
+            body = self.client.add_box(target.start, (w, d, 2 * 0.5))
+            self.names[body] = "target"
+
+    def _move_movers(self) -> None:
+        reset = self.client.call
+        for mover, body in self.movers:
+            reset("resetBasePositionAndOrientation", body, mover.position_at(self.t).tolist(),
+                  [0.0, 0.0, 0.0, 1.0])
 
     # -- the co-simulation contract ------------------------------------------------------
     def execute(self, robot: Robot, motion: Motion) -> simpy.Event:
@@ -127,7 +150,7 @@ class PhysicsCoSim:
                done: simpy.Event) -> Generator[simpy.Event, Any, Sighting | None]:
         track = robot.motion
         while not done.triggered and robot.motion is track:
-            hit = sensor.sighting_from(robot, robot.position(self.env.now))
+            hit = sensor.sighting_from(robot, robot.position(self.env.now), self.env.now)
             if hit is not None:
                 return hit
             yield self.env.timeout(1.0 / self.spec.log_rate)
@@ -170,6 +193,8 @@ class PhysicsCoSim:
                         if (out := self._tick(rid, track, check)) is not None]
             if finished:
                 return finished
+            if self.movers:
+                self._move_movers()
             self.client.step()
             self.t += self.period
             self._ticks += 1

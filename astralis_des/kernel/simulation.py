@@ -20,6 +20,7 @@ from astralis_des.kernel.events import EventLog
 from astralis_des.kernel.handler import TaskHandler
 from astralis_des.kernel.result import RunResult, build_result
 from astralis_des.kernel.robot import Robot
+from astralis_des.kernel.scene import Scene
 from astralis_des.kernel.tasks import ActionResult, Stop, Task, TaskStatus
 from astralis_des.kernel.timeline import scheduled, search
 from astralis_des.kernel.world_state import draw_rooms, draw_target
@@ -44,8 +45,11 @@ class Simulation:
         self.env = simpy.Environment()
         self.log = EventLog(self.env)
         self.rooms = draw_rooms(mission)
-        self.target = draw_target(mission)
-        self.sensor = GeometricSensor(self.world, np.array(self.target.position))
+        self.scene = Scene(self.world, {r: s.messiness for r, s in self.rooms.items()},
+                           spec.seed, mission.clutter_catalogue(), clutter=spec.scene.clutter,
+                           movers=spec.scene.movers, mover_speed=spec.scene.mover_speed)
+        self.target = draw_target(mission, self.scene)
+        self.sensor = GeometricSensor(self.scene, self.target)
         self.found = self.env.event()
         self.rounds: list[dict[str, Any]] = []
         self.searched: list[str] = []
@@ -165,8 +169,9 @@ class Simulation:
         if self.found.triggered:
             return
         self.log.emit("detection", robot.id, target_room=self.target.room,
-                      target_position=self.target.position, robot_position=sighting.robot_position,
-                      distance=sighting.distance, avatar=self.target.avatar)
+                      target_position=sighting.target_position,
+                      robot_position=sighting.robot_position, distance=sighting.distance,
+                      avatar=self.target.avatar)
         self.found.succeed(robot.id)
 
     # -- running ---------------------------------------------------------------------------

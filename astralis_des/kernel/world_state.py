@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from astralis_des.kinds import TARGET_HEIGHT
+from astralis_des.kernel.scene import Scene, Target
 from astralis_des.mission.loader import Mission
 
 SOUNDS = ("minimal", "moderate", "loud")
@@ -32,13 +32,6 @@ class RoomState:
     sound: str
 
 
-@dataclass(frozen=True)
-class Target:
-    room: str
-    position: tuple[float, float, float]
-    avatar: dict[str, object]
-
-
 def draw_rooms(mission: Mission) -> dict[str, RoomState]:
     """Uniform risk and messiness in [0, 1] and a sound per room, then the file's overrides."""
     gen = rng(mission.spec.seed, "rooms")
@@ -53,23 +46,18 @@ def draw_rooms(mission: Mission) -> dict[str, RoomState]:
     return states
 
 
-def draw_target(mission: Mission) -> Target:
+def draw_target(mission: Mission, scene: Scene) -> Target:
+    """The target avatar: its room (given or drawn from the searched rooms), attributes (given
+    or drawn from Table II), and place (given, or a free spot among the furniture)."""
     spec = mission.spec.target
     gen = rng(mission.spec.seed, "target")
     candidates = mission.searched_rooms() or sorted(mission.world.rooms)
     room_id = spec.room or candidates[int(gen.integers(len(candidates)))]
-    room = mission.world.rooms[room_id]
-    if spec.position is not None:
-        position = tuple(float(v) for v in spec.position)
-    else:
-        inset = 0.4
-        x = gen.uniform(room.box.lo[0] + inset, room.box.hi[0] - inset)
-        y = gen.uniform(room.box.lo[1] + inset, room.box.hi[1] - inset)
-        position = (float(x), float(y), room.box.lo[2] + TARGET_HEIGHT)
     given = spec.avatar.model_dump(exclude_none=True)
     avatar_gen = rng(mission.spec.seed, "avatar")
     avatar = {}
     for key, values in AVATAR_VALUES.items():
         drawn = values[int(avatar_gen.integers(len(values)))]
         avatar[key] = given.get(key, drawn)
-    return Target(room_id, position, avatar)  # type: ignore[arg-type]
+    position = tuple(float(v) for v in spec.position) if spec.position is not None else None
+    return scene.place_target(room_id, avatar, position)  # type: ignore[arg-type]

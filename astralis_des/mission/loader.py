@@ -11,6 +11,7 @@ from astralis_des.mission.spec import CommandEvent, MissionSpec
 from astralis_des.registry import UnknownEntry
 from astralis_des.validation import validate
 from astralis_des.world.build import load_world
+from astralis_des.world.catalogue import Catalogue, default_catalogue, load_catalogue
 from astralis_des.world.model import World
 from astralis_des.yamlio import KeyPath, LocatedYaml, load_yaml
 
@@ -22,6 +23,10 @@ class Mission:
     spec: MissionSpec
     world: World
     path: Path | None = None
+    catalogue: Catalogue | None = None  # None: the packaged default
+
+    def clutter_catalogue(self) -> Catalogue:
+        return self.catalogue if self.catalogue is not None else default_catalogue()
 
     @property
     def name(self) -> str:
@@ -58,7 +63,13 @@ def load_mission(path: str | Path) -> Mission:
         raise doc.error(("world",), f"no such world file: {world_path}")
     world = load_world(world_path)
     _check_references(spec, world, doc)
-    return Mission(spec, world, doc.file)
+    catalogue = None
+    if spec.scene.catalogue is not None:
+        where = (doc.file.parent / spec.scene.catalogue).resolve()
+        if not where.is_file():
+            raise doc.error(("scene", "catalogue"), f"no such catalogue file: {where}")
+        catalogue = load_catalogue(where)
+    return Mission(spec, world, doc.file, catalogue)
 
 
 def _validate(doc: LocatedYaml) -> MissionSpec:

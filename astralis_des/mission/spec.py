@@ -185,6 +185,16 @@ class PhysicsSpec(Strict):
         return 1.0 / self.rate
 
 
+class SceneSpec(Strict):
+    """What the mission adds to its world: furniture and avatars by each room's messiness
+    (from the catalogue), and moving obstacles wandering in the corridors."""
+
+    clutter: bool = True
+    catalogue: str | None = Field(None, description="catalogue file, relative to the mission")
+    movers: int = Field(0, ge=0, le=100, description="moving obstacles in corridors")
+    mover_speed: PositiveFloat = 0.6
+
+
 class OutputsSpec(Strict):
     dir: str | None = Field(None, description="default: out/<mission name>")
     events: bool = True
@@ -203,6 +213,7 @@ class MissionSpec(Strict):
     target: TargetSpec = Field(default_factory=TargetSpec)
     assignment: AssignmentSpec = Field(default_factory=AssignmentSpec)
     timeline: list[TimelineEvent] = Field(default_factory=list)
+    scene: SceneSpec = Field(default_factory=SceneSpec)
     physics: PhysicsSpec = Field(default_factory=PhysicsSpec)
     outputs: OutputsSpec = Field(default_factory=OutputsSpec)
 

@@ -46,12 +46,22 @@ class PhysicsClient:
         return getattr(pb, name)(*args, physicsClientId=self.id, **kwargs)
 
     def _add_static(self, world: World) -> int:
-        lo = np.array([s.box.lo for s in world.solids])
-        hi = np.array([s.box.hi for s in world.solids])
+        return self.add_boxes([s.box.lo for s in world.solids], [s.box.hi for s in world.solids])
+
+    def add_boxes(self, los: Any, his: Any) -> int:
+        """One static compound body of axis-aligned boxes given by their corners."""
+        lo, hi = np.asarray(los, dtype=float), np.asarray(his, dtype=float)
         shape = self.call("createCollisionShapeArray", [pb.GEOM_BOX] * len(lo),
                           halfExtents=((hi - lo) / 2).tolist(),
                           collisionFramePositions=((hi + lo) / 2).tolist())
         return int(self.call("createMultiBody", 0, shape))
+
+    def add_box(self, centre: Any, size: Any) -> int:
+        """A box body without mass: static, or moved kinematically by resetting its pose."""
+        shape = self.call("createCollisionShape", pb.GEOM_BOX,
+                          halfExtents=[float(v) / 2 for v in size])
+        return int(self.call("createMultiBody", 0, shape,
+                             basePosition=[float(v) for v in centre]))
 
     def step(self, calls: int = 1) -> None:
         """Advance ``calls`` x ``substeps`` physics steps of ``dt``."""

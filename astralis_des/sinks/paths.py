@@ -7,6 +7,7 @@ TIMELINE = "sim_time"
 WORLD_SOLIDS = "world/solids"
 WORLD_ROOMS = "world/rooms"
 WORLD_TARGET = "world/target"
+WORLD_FURNITURE = "world/furniture"
 MISSION_EVENTS = "mission/events"
 MISSION_ROUNDS = "mission/assignment"
 
@@ -25,3 +26,7 @@ def robot_trail(robot_id: str) -> str:
 
 def robot_task(robot_id: str) -> str:
     return f"robots/{robot_id}/task"
+
+
+def mover(mover_id: str) -> str:
+    return "world/movers/" + mover_id.replace(":", "_")

@@ -3,13 +3,16 @@ trails, each robot's task and the events as text, on one ``sim_time`` timeline."
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from astralis_des.kernel.events import LEVELS, Record
 from astralis_des.sinks import paths
+from astralis_des.world.clutter import Placed
+from astralis_des.world.model import World
 
 if TYPE_CHECKING:
     from astralis_des.kernel.result import RunResult
@@ -17,6 +20,9 @@ if TYPE_CHECKING:
 
 SOLID_COLORS = {"wall": (170, 170, 180, 255), "slab": (120, 120, 130, 60)}
 OBSTACLE_COLOR = (60, 140, 60, 255)
+FURNITURE_COLORS = {"chair": (139, 90, 43, 255), "cabinet": (110, 110, 90, 255),
+                    "table": (181, 136, 99, 255), "potted_plant": (34, 139, 34, 255),
+                    "computer_desk": (90, 90, 130, 255), "avatar": (250, 200, 60, 255)}
 ROBOT_COLORS = {"uav": (30, 144, 255, 255), "ugv": (255, 165, 0, 255), "human": (220, 20, 60, 255)}
 
 
@@ -51,13 +57,9 @@ class RerunRecorder:
         self._log_world()
 
     def _log_world(self) -> None:
-        rr, rec, world = self.rr, self.rec, self.sim.world
-        lo = np.array([s.box.lo for s in world.solids])
-        hi = np.array([s.box.hi for s in world.solids])
-        colors = [SOLID_COLORS.get(s.kind, OBSTACLE_COLOR) for s in world.solids]
-        rec.log(paths.WORLD_SOLIDS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
-                                               colors=colors, fill_mode="solid"), static=True)
-        target = self.sim.target
+        rr, rec, sim = self.rr, self.rec, self.sim
+        log_solids(rr, rec, sim.world)
+        target = sim.target
         rec.log(paths.WORLD_TARGET, rr.Points3D([target.position], radii=0.3,
                                                 colors=[(255, 0, 255)],
                                                 labels=[f"target ({target.avatar['color']})"]),
@@ -65,17 +67,21 @@ class RerunRecorder:
         rec.set_time(paths.TIMELINE, duration=0.0)
         self._log_rooms()
 
+    def _log_movers(self, end: float) -> None:
+        """Patrolling avatars and moving obstacles, sampled at 2 Hz, in columns."""
+        rr, scene = self.rr, self.sim.scene
+        times = np.arange(0.0, end + 0.5, 0.5)
+        for mover in [*scene.movers, *scene.avatar_movers()]:
+            path = paths.mover(mover.id)
+            self.rec.send_columns(path, indexes=[rr.TimeColumn(paths.TIMELINE, duration=times)],
+                                  columns=rr.Boxes3D.columns(centers=mover.positions_at(times)))
+            self.rec.log(path, rr.Boxes3D.from_fields(
+                half_sizes=[np.array(mover.size) / 2], labels=[mover.id],
+                colors=[(255, 0, 255, 255) if mover.id == "target" else (200, 120, 40, 255)]),
+                static=True)
+
     def _log_rooms(self) -> None:
-        rr, world, states = self.rr, self.sim.world, self.sim.rooms
-        ids = sorted(world.rooms)
-        lo = np.array([world.rooms[r].box.lo for r in ids])
-        hi = np.array([world.rooms[r].box.hi for r in ids])
-        colors = [(int(255 * states[r].risk), 60, int(255 * states[r].messiness), 90) for r in ids]
-        labels = [f"{r} risk {states[r].risk:.2f} mess {states[r].messiness:.2f} "
-                  f"{states[r].sound}" for r in ids]
-        self.rec.log(paths.WORLD_ROOMS, rr.Boxes3D(centers=(lo + hi) / 2,
-                                                   half_sizes=(hi - lo) / 2, colors=colors,
-                                                   labels=labels, show_labels=False))
+        log_rooms(self.rr, self.rec, self.sim.world, self.sim.rooms)
 
     def _text(self, entity: str) -> _TextColumn:
         return self._texts.setdefault(entity, _TextColumn())
@@ -93,6 +99,8 @@ class RerunRecorder:
 
     def close(self, result: RunResult) -> None:
         rr, rec = self.rr, self.rec
+        log_furniture(rr, rec, self.sim.scene.furnished())
+        self._log_movers(result.end_time)
         for entity, column in self._texts.items():
             rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE,
                                                             duration=column.times)],
@@ -122,3 +130,38 @@ def describe(record: Record) -> str:
         parts.append(", ".join(f"{m['agent']}->{m['room']} {m['action']}"
                                for m in record["matching"]))
     return " ".join(p for p in parts if p)
+
+
+def log_solids(rr: Any, rec: Any, world: World) -> None:
+    """Walls, slabs and outdoor obstacles, once (static)."""
+    lo = np.array([s.box.lo for s in world.solids])
+    hi = np.array([s.box.hi for s in world.solids])
+    colors = [SOLID_COLORS.get(s.kind, OBSTACLE_COLOR) for s in world.solids]
+    rec.log(paths.WORLD_SOLIDS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
+                                           colors=colors, fill_mode="solid"), static=True)
+
+
+def log_rooms(rr: Any, rec: Any, world: World, states: Mapping[str, Any]) -> None:
+    """Rooms as translucent boxes, red by risk and blue by messiness, labelled."""
+    ids = sorted(world.rooms)
+    lo = np.array([world.rooms[r].box.lo for r in ids])
+    hi = np.array([world.rooms[r].box.hi for r in ids])
+    colors = [(int(255 * states[r].risk), 60, int(255 * states[r].messiness), 90) for r in ids]
+    labels = [f"{r} risk {states[r].risk:.2f} mess {states[r].messiness:.2f} "
+              f"{states[r].sound}" for r in ids]
+    rec.log(paths.WORLD_ROOMS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
+                                          colors=colors, labels=labels, show_labels=False))
+
+
+def log_furniture(rr: Any, rec: Any, placed: Sequence[Placed]) -> None:
+    """Furniture and avatars, once (static), coloured by kind."""
+    if not placed:
+        return
+    lo = np.array([p.box.lo for p in placed])
+    hi = np.array([p.box.hi for p in placed])
+    colors = [FURNITURE_COLORS.get(p.kind, (150, 150, 150, 255)) for p in placed]
+    labels = [p.kind if p.kind != "avatar" else
+              "avatar " + " ".join(str(v) for _, v in p.attributes) for p in placed]
+    rec.log(paths.WORLD_FURNITURE, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
+                                              colors=colors, labels=labels, show_labels=False,
+                                              fill_mode="solid"), static=True)

@@ -135,19 +135,20 @@ class World:
         return 0.0 <= x <= self.site[0] and 0.0 <= y <= self.site[1]
 
     @cached_property
-    def _room_ids(self) -> list[str]:
+    def room_ids(self) -> list[str]:
         return list(self.rooms)
 
     @cached_property
-    def _room_array(self) -> FloatArray:
-        return boxes_array([self.rooms[r].box for r in self._room_ids])
+    def room_boxes(self) -> FloatArray:
+        """``(R, 2, 3)`` corners of the rooms, in ``room_ids`` order."""
+        return boxes_array([self.rooms[r].box for r in self.room_ids])
 
     def room_at(self, point: tuple[float, ...] | FloatArray) -> Room | None:
         p = np.asarray(point, dtype=float)
-        boxes = self._room_array
+        boxes = self.room_boxes
         inside = np.all((p >= boxes[:, 0] - 1e-6) & (p <= boxes[:, 1] + 1e-6), axis=1)
         hit = np.flatnonzero(inside)
-        return self.rooms[self._room_ids[hit[0]]] if len(hit) else None
+        return self.rooms[self.room_ids[hit[0]]] if len(hit) else None
 
     def line_of_sight(self, p0: FloatArray, p1: FloatArray) -> np.ndarray:
         """``(M,)`` mask, true where the segment ``p0[m] -> p1[m]`` meets no solid."""

@@ -1,0 +1,219 @@
+"""What a run adds to its world: furniture by messiness, avatars (the target among them),
+patrolling avatars and moving obstacles.
+
+Furniture is placed per room, lazily and with one generator per room, so that a kinematic
+mission only pays for the rooms it looks into and the result never depends on the order in
+which rooms are looked at. Whatever moves follows a closed loop at its speed, so its position
+is known at any time, in both fidelities.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from astralis_des.actions import coverage as cov
+from astralis_des.kinds import TARGET_HEIGHT
+from astralis_des.world.catalogue import Catalogue
+from astralis_des.world.clutter import Clutter, Placed, free_spot, place_room
+from astralis_des.world.geometry import Box, FloatArray, boxes_array, segments_hit_boxes
+from astralis_des.world.model import World
+
+STANDING = (0.5, 0.5)  # m, footprint of a sitting, standing or walking avatar
+LAYING = (1.8, 0.6)
+PATROL_INSET = 1.0  # m from the walls of a patrolled room
+AVATAR_HEIGHTS = {"tall": 1.85, "medium": 1.72, "short": 1.58}
+STREAMS = {"target": 2, "movers": 5}
+
+
+@dataclass(frozen=True)
+class Mover:
+    """A body going round a closed loop at constant speed: a patrolling avatar or an obstacle."""
+
+    id: str
+    kind: str  # avatar | obstacle
+    loop: FloatArray  # (N, 3), first point repeated last; the body's centre
+    speed: float
+    size: tuple[float, float, float]
+    offset: float = 0.0  # arc length along the loop at t = 0
+    attributes: tuple[tuple[str, Any], ...] = ()
+    cum: FloatArray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        seg = np.linalg.norm(np.diff(self.loop, axis=0), axis=1)
+        object.__setattr__(self, "cum", np.concatenate([[0.0], np.cumsum(seg)]))
+
+    def positions_at(self, times: FloatArray) -> FloatArray:
+        s = (self.offset + self.speed * np.asarray(times, dtype=float)) % max(self.cum[-1], 1e-9)
+        return np.column_stack([np.interp(s, self.cum, self.loop[:, k]) for k in range(3)])
+
+    def position_at(self, t: float) -> FloatArray:
+        return self.positions_at(np.array([t]))[0]
+
+
+@dataclass(frozen=True)
+class Target:
+    """The avatar the team searches for; it may patrol its room."""
+
+    room: str
+    avatar: dict[str, Any]
+    start: tuple[float, float, float]  # centre of the body at t = 0
+    mover: Mover | None = None
+
+    @property
+    def position(self) -> tuple[float, float, float]:
+        return self.start
+
+    def positions_at(self, times: FloatArray) -> FloatArray:
+        if self.mover is None:
+            return np.repeat(np.array([self.start]), len(np.atleast_1d(times)), axis=0)
+        return self.mover.positions_at(times)
+
+    def position_at(self, t: float) -> FloatArray:
+        return self.positions_at(np.array([t]))[0]
+
+
+class Scene:
+    def __init__(self, world: World, messiness: Mapping[str, float], seed: int,
+                 catalogue: Catalogue, *, clutter: bool = True, movers: int = 0,
+                 mover_speed: float = 0.6) -> None:
+        self.world = world
+        self.messiness = dict(messiness)
+        self.seed = seed
+        self.catalogue = catalogue
+        self.enabled = clutter
+        self._order = {rid: i for i, rid in enumerate(sorted(world.rooms))}
+        self._rooms: dict[str, Clutter] = {}
+        self._reserved: dict[str, Box] = {}  # room -> the target's footprint, kept free
+        self.target: Target | None = None
+        self.movers: list[Mover] = self._corridor_movers(movers, mover_speed)
+
+    # -- clutter ---------------------------------------------------------------------------
+    def clutter(self, room_id: str) -> Clutter:
+        """The room's furniture and avatars, placed on first use."""
+        if room_id not in self._rooms:
+            if not self.enabled:
+                self._rooms[room_id] = Clutter((), ())
+            else:
+                rng = np.random.default_rng([self.seed, 4, self._order[room_id]])
+                placed = place_room(self.world, room_id, self.messiness.get(room_id, 0.0), rng,
+                                    self.catalogue)
+                self._rooms[room_id] = self._clear_target(room_id, placed)
+        return self._rooms[room_id]
+
+    def _clear_target(self, room_id: str, placed: Clutter) -> Clutter:
+        keep = self._reserved.get(room_id)
+        if keep is None:
+            return placed
+        blocked = [p for p in placed.placed if _overlap(p.box, keep)]
+        return Clutter(tuple(p for p in placed.placed if p not in blocked),
+                       placed.skipped + tuple((room_id, p.kind, "moved aside for the target")
+                                              for p in blocked))
+
+    def all_clutter(self) -> list[Placed]:
+        """Every room's furniture and avatars (furnishing the rooms not yet looked into)."""
+        return [p for rid in sorted(self.world.rooms) for p in self.clutter(rid).placed]
+
+    def furnished(self) -> list[Placed]:
+        """The furniture and avatars of the rooms furnished so far: in kinematic fidelity the
+        rooms the team looked into; in physics, all of them."""
+        return [p for rid in sorted(self._rooms) for p in self._rooms[rid].placed]
+
+    def skipped(self) -> list[tuple[str, str, str]]:
+        return [s for rid in sorted(self._rooms) for s in self._rooms[rid].skipped]
+
+    def static_bodies(self, room_ids: Iterable[str]) -> list[Placed]:
+        """Furniture and avatars that stay put (not the patrolling ones) in these rooms."""
+        return [p for rid in room_ids for p in self.clutter(rid).placed
+                if dict(p.attributes).get("activity") != "patrolling"]
+
+    def avatar_movers(self) -> list[Mover]:
+        """Patrolling bystanders and a patrolling target, as movers."""
+        found: list[Mover] = []
+        for rid in sorted(self.world.rooms):
+            for p in self.clutter(rid).placed:
+                if dict(p.attributes).get("activity") == "patrolling":
+                    found.append(self._patrol(f"avatar:{rid}:{len(found)}", rid, p.center,
+                                              p.size, p.attributes))
+        if self.target is not None and self.target.mover is not None:
+            found.append(self.target.mover)
+        return found
+
+    # -- the target ------------------------------------------------------------------------
+    def place_target(self, room_id: str, avatar: dict[str, Any],
+                     position: tuple[float, float, float] | None) -> Target:
+        """Put the target avatar in its room: at ``position``, or on a free spot."""
+        laying = avatar.get("activity") == "laying"
+        w, d = LAYING if laying else STANDING
+        room = self.world.rooms[room_id]
+        floor = room.box.lo[2]
+        if position is None:
+            rng = np.random.default_rng([self.seed, STREAMS["target"], 1])
+            spot = free_spot(self.world, room_id, self.clutter(room_id), (w, d), rng,
+                             self.catalogue)
+            if spot is None:  # no free spot left: the room's centre, furniture moved aside
+                spot = room.center[:2]
+            position = (float(spot[0]), float(spot[1]), floor + TARGET_HEIGHT)
+        self._reserved[room_id] = Box((position[0] - w / 2, position[1] - d / 2, floor),
+                                      (position[0] + w / 2, position[1] + d / 2, floor + 1.8))
+        if room_id in self._rooms:
+            self._rooms[room_id] = self._clear_target(room_id, self._rooms[room_id])
+        mover = None
+        if avatar.get("activity") == "patrolling":
+            height = AVATAR_HEIGHTS.get(str(avatar.get("height")), 1.72)
+            mover = self._patrol("target", room_id, position, (w, d, height),
+                                 tuple(avatar.items()))
+        self.target = Target(room_id, dict(avatar), position, mover)
+        return self.target
+
+    def _patrol(self, ident: str, room_id: str, where: tuple[float, ...],
+                size: tuple[float, float, float], attributes: tuple[tuple[str, Any], ...]) -> Mover:
+        room = self.world.rooms[room_id]
+        ring = cov.loop(room.box, PATROL_INSET)
+        loop = np.column_stack([ring, np.full(len(ring), where[2])])
+        mover = Mover(ident, "avatar", loop, 1.0, size, attributes=attributes)
+        nearest = int(np.argmin(np.linalg.norm(loop[:, :2] - np.array(where[:2]), axis=1)))
+        return Mover(ident, "avatar", loop, 1.0, size, float(mover.cum[nearest]), attributes)
+
+    # -- moving obstacles ------------------------------------------------------------------
+    def _corridor_movers(self, count: int, speed: float) -> list[Mover]:
+        rng = np.random.default_rng([self.seed, STREAMS["movers"]])
+        corridors = sorted(s for s, sp in self.world.spaces.items() if sp.kind == "corridor")
+        movers = []
+        for i in range(count):
+            box = self.world.spaces[corridors[int(rng.integers(len(corridors)))]].box
+            y = (box.lo[1] + box.hi[1]) / 2
+            x0, x1 = sorted(rng.uniform(box.lo[0] + 0.5, box.hi[0] - 0.5, size=2))
+            z = box.lo[2] + 0.5
+            loop = np.array([[x0, y, z], [x1, y, z], [x0, y, z]])
+            movers.append(Mover(f"obstacle:{i}", "obstacle", loop, speed * rng.uniform(0.7, 1.3),
+                                (0.5, 0.5, 1.0), float(rng.uniform(0, 2 * (x1 - x0)))))
+        return movers
+
+    # -- sight -----------------------------------------------------------------------------
+    def blockers(self, rooms: Iterable[str]) -> FloatArray:
+        """Boxes that block sight: walls, slabs, obstacles, and the furniture and avatars that
+        stay put in ``rooms`` (the target excluded)."""
+        extra = boxes_array([p.box for p in self.static_bodies(rooms)])
+        return np.concatenate([self.world.solid_array, extra]) if len(extra) else \
+            self.world.solid_array
+
+    def line_of_sight(self, p0: FloatArray, p1: FloatArray) -> np.ndarray:
+        """True where nothing lies between ``p0[m]`` and ``p1[m]``. Only the furniture of the
+        rooms the segments start or end in can matter: to reach into any other room a
+        segment passes through a wall, which blocks it already."""
+        p0, p1 = np.atleast_2d(p0), np.atleast_2d(p1)
+        ends = np.concatenate([p0, p1])
+        boxes = self.world.room_boxes
+        near = np.flatnonzero(np.all((boxes[:, 0] <= ends.max(axis=0)) &
+                                     (boxes[:, 1] >= ends.min(axis=0)), axis=1))
+        rooms = [self.world.room_ids[k] for k in near if np.any(np.all(
+            (ends >= boxes[k, 0]) & (ends <= boxes[k, 1]), axis=1))]
+        return ~segments_hit_boxes(p0, p1, self.blockers(rooms))
+
+
+def _overlap(a: Box, b: Box) -> bool:
+    return all(a.lo[k] < b.hi[k] and b.lo[k] < a.hi[k] for k in range(2))

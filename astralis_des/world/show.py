@@ -1,0 +1,54 @@
+"""``astralis world show``: a recording of a world alone, furnished at a messiness."""
+
+from __future__ import annotations
+
+import os
+from collections import Counter
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from astralis_des.errors import InputError
+from astralis_des.kernel.scene import Scene
+from astralis_des.kernel.world_state import RoomState
+from astralis_des.world.build import load_world
+from astralis_des.world.catalogue import default_catalogue, load_catalogue
+
+
+@dataclass(frozen=True)
+class Shown:
+    path: Path
+    rooms: int
+    placed: Counter[str]
+    skipped: list[tuple[str, str, str]]
+
+
+def show_world(world_file: str | Path, messiness: Sequence[float], out: str | Path, *,
+               seed: int = 0, catalogue: str | Path | None = None) -> Shown:
+    """Furnish every room (``messiness`` given for all rooms, or cycled over them in id order)
+    and write the world alone to a Rerun recording at ``out``."""
+    import rerun as rr
+
+    from astralis_des.sinks.recording import log_furniture, log_rooms, log_solids
+
+    for value in messiness:
+        if not 0.0 <= value <= 1.0:
+            raise InputError(f"{value:g} is outside [0, 1]", key="--messiness")
+    world = load_world(Path(world_file).resolve())
+    cat = load_catalogue(Path(catalogue)) if catalogue is not None else default_catalogue()
+    ids = sorted(world.rooms)
+    values = {rid: float(messiness[i % len(messiness)]) for i, rid in enumerate(ids)}
+    scene = Scene(world, values, seed, cat)
+    placed = scene.all_clutter()
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    partial = out.with_name(out.name + ".partial")
+    rec = rr.RecordingStream("astralis_des", recording_id=f"world-{world.name}-{seed}")
+    rec.save(partial)
+    log_solids(rr, rec, world)
+    log_rooms(rr, rec, world, {rid: RoomState(0.0, values[rid], "minimal") for rid in ids})
+    log_furniture(rr, rec, placed)
+    rec.flush()
+    rec.disconnect()
+    os.replace(partial, out)
+    return Shown(out, len(ids), Counter(p.kind for p in placed), scene.skipped())
