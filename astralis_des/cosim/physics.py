@@ -111,9 +111,10 @@ class PhysicsCoSim:
             self.names[body] = "target"
 
     def _move_movers(self) -> None:
-        reset = self.client.call
+        """Put each mover where it is at the end of the coming tick."""
+        reset, then = self.client.call, self.t + self.period
         for mover, body in self.movers:
-            reset("resetBasePositionAndOrientation", body, mover.position_at(self.t).tolist(),
+            reset("resetBasePositionAndOrientation", body, mover.position_at(then).tolist(),
                   [0.0, 0.0, 0.0, 1.0])
 
     # -- the co-simulation contract ------------------------------------------------------
