@@ -7,12 +7,14 @@ from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from astralis_des.errors import InputError
 from astralis_des.kernel.scene import Scene
 from astralis_des.kernel.world_state import RoomState
 from astralis_des.world.build import load_world
 from astralis_des.world.catalogue import default_catalogue, load_catalogue
+from astralis_des.world.model import World
 
 
 @dataclass(frozen=True)
@@ -44,7 +46,7 @@ def show_world(world_file: str | Path, messiness: Sequence[float], out: str | Pa
     out.parent.mkdir(parents=True, exist_ok=True)
     partial = out.with_name(out.name + ".partial")
     rec = rr.RecordingStream("astralis_des", recording_id=f"world-{world.name}-{seed}")
-    rec.save(partial)
+    rec.save(partial, default_blueprint=_overview(world))
     log_solids(rr, rec, world)
     log_rooms(rr, rec, world, {rid: RoomState(0.0, values[rid], "minimal") for rid in ids})
     log_furniture(rr, rec, placed)
@@ -52,3 +54,17 @@ def show_world(world_file: str | Path, messiness: Sequence[float], out: str | Pa
     rec.disconnect()
     os.replace(partial, out)
     return Shown(out, len(ids), Counter(p.kind for p in placed), scene.skipped())
+
+
+def _overview(world: World) -> Any:
+    """A 3-D view looking down at the first building from the south, steep enough to see
+    into its rooms over the walls."""
+    import rerun.blueprint as rrb
+
+    box = next(iter(world.buildings.values())).footprint
+    cx, cy = (box.lo[0] + box.hi[0]) / 2, (box.lo[1] + box.hi[1]) / 2
+    span = max(box.hi[0] - box.lo[0], box.hi[1] - box.lo[1])
+    eye = rrb.EyeControls3D(position=(cx, box.lo[1] - 0.35 * span, 1.1 * span),
+                            look_target=(cx, cy, 0.0))
+    return rrb.Blueprint(rrb.Spatial3DView(origin="/", name=world.name, eye_controls=eye),
+                         collapse_panels=True)
