@@ -131,10 +131,10 @@ class Scene:
                 if dict(p.attributes).get("activity") != "patrolling"]
 
     def avatar_movers(self) -> list[Mover]:
-        """Patrolling bystanders and a patrolling target, as movers."""
+        """Patrolling bystanders of the furnished rooms and a patrolling target, as movers."""
         found: list[Mover] = []
-        for rid in sorted(self.world.rooms):
-            for p in self.clutter(rid).placed:
+        for rid in sorted(self._rooms):
+            for p in self._rooms[rid].placed:
                 if dict(p.attributes).get("activity") == "patrolling":
                     found.append(self._patrol(f"avatar:{rid}:{len(found)}", rid, p.center,
                                               p.size, p.attributes))

@@ -16,6 +16,7 @@ import sys
 import tempfile
 import time
 from collections import Counter
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import simpy
@@ -63,6 +64,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--missions", type=int, default=1000)
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--workers", type=int, default=2,
+                        help="also run the missions on this many processes")
     args = parser.parse_args()
     mission_file = ROOT / "missions" / "urban_search.yaml"
 
@@ -97,18 +100,38 @@ def main() -> None:
     print(f"  bare SimPy replay of its tasks:     {bare * 1e3:8.2f} ms  -> ours / bare = "
           f"{off / bare:.0f}x")
 
-    seeds = range(args.missions)
-    t0 = time.perf_counter()
-    outcomes: Counter[str] = Counter()
-    sim_total = 0.0
-    for seed in seeds:
-        r = Simulation(mission.with_changes(seed=seed)).run()
-        outcomes[r.outcome] += 1
-        sim_total += r.end_time
-    total = time.perf_counter() - t0
     print(f"{args.missions} kinematic missions, recording off (seeds 0..{args.missions - 1}):")
-    print(f"  total {total:.1f} s (goal < 60 s), {args.missions / total:.0f} missions/s, "
-          f"mean real-time factor {sim_total / total:.0f}x; outcomes {dict(outcomes)}")
+    single = None
+    for workers in sorted({1, args.workers}):
+        t0 = time.perf_counter()
+        if workers == 1:
+            runs = [run_seed(seed) for seed in range(args.missions)]
+        else:
+            with ProcessPoolExecutor(workers, initializer=load_once) as pool:
+                runs = list(pool.map(run_seed, range(args.missions), chunksize=25))
+        total = time.perf_counter() - t0
+        single = single or total
+        outcomes = Counter(outcome for outcome, _ in runs)
+        print(f"  {workers} process{'es' if workers > 1 else ''}: {total:.1f} s (goal < 60 s), "
+              f"{args.missions / total:.0f} missions/s, mean real-time factor "
+              f"{sum(t for _, t in runs) / total:.0f}x; speed-up {single / total:.2f}; "
+              f"outcomes {dict(outcomes)}")
+
+
+_MISSION = None
+
+
+def load_once() -> None:
+    global _MISSION
+    _MISSION = load_mission(ROOT / "missions" / "urban_search.yaml")
+
+
+def run_seed(seed: int) -> tuple[str, float]:
+    if _MISSION is None:
+        load_once()
+    assert _MISSION is not None
+    result = Simulation(_MISSION.with_changes(seed=seed)).run()
+    return result.outcome, result.end_time
 
 
 if __name__ == "__main__":
