@@ -191,3 +191,16 @@ def test_world_show_refuses_a_messiness_outside_0_1(tmp_path: Path,
     assert code == 2
     assert capsys.readouterr().err.strip() == "error: --messiness: 1.5 is outside [0, 1]"
     assert not out.exists()
+
+
+def test_items_a_room_has_no_place_for_are_events(urban_search: Mission, tmp_path: Path) -> None:
+    """At messiness 1 some avatars find no spot: each is a clutter_skipped event, logged
+    after mission_start and written to events.jsonl like any other."""
+    mission = urban_search.with_changes(rooms={"set": {
+        rid: {"messiness": 1.0} for rid in urban_search.world.rooms}})
+    result = Simulation(mission, out_dir=tmp_path).run()
+    skipped = [e for e in result.events if e["kind"] == "clutter_skipped"]
+    assert skipped and all(e["reason"] and e["item"] and e["room"] for e in skipped)
+    assert result.events[0]["kind"] == "mission_start"
+    lines = (tmp_path / "events.jsonl").read_text(encoding="utf-8").splitlines()
+    assert len(lines) == len(result.events)

@@ -9,7 +9,7 @@ is known at any time, in both fidelities.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -79,12 +79,14 @@ class Target:
 class Scene:
     def __init__(self, world: World, messiness: Mapping[str, float], seed: int,
                  catalogue: Catalogue, *, clutter: bool = True, movers: int = 0,
-                 mover_speed: float = 0.6) -> None:
+                 mover_speed: float = 0.6,
+                 on_skipped: Callable[[str, str, str], None] | None = None) -> None:
         self.world = world
         self.messiness = dict(messiness)
         self.seed = seed
         self.catalogue = catalogue
         self.enabled = clutter
+        self.on_skipped = on_skipped  # told of each item a room had no place for
         self._order = {rid: i for i, rid in enumerate(sorted(world.rooms))}
         self._rooms: dict[str, Clutter] = {}
         self._reserved: dict[str, Box] = {}  # room -> the target's footprint, kept free
@@ -102,6 +104,9 @@ class Scene:
                 placed = place_room(self.world, room_id, self.messiness.get(room_id, 0.0), rng,
                                     self.catalogue)
                 self._rooms[room_id] = self._clear_target(room_id, placed)
+                if self.on_skipped is not None:
+                    for skipped in self._rooms[room_id].skipped:
+                        self.on_skipped(*skipped)
         return self._rooms[room_id]
 
     def _clear_target(self, room_id: str, placed: Clutter) -> Clutter:

@@ -47,7 +47,8 @@ class Simulation:
         self.rooms = draw_rooms(mission)
         self.scene = Scene(self.world, {r: s.messiness for r, s in self.rooms.items()},
                            spec.seed, mission.clutter_catalogue(), clutter=spec.scene.clutter,
-                           movers=spec.scene.movers, mover_speed=spec.scene.mover_speed)
+                           movers=spec.scene.movers, mover_speed=spec.scene.mover_speed,
+                           on_skipped=self._not_placed)
         self.target = draw_target(mission, self.scene)
         self.sensor = GeometricSensor(self.scene, self.target)
         self.found = self.env.event()
@@ -59,6 +60,7 @@ class Simulation:
         self._ids = itertools.count(1)
         self._started: dict[str, tuple[int, float]] = {}  # robot -> running task, its start
         self._handlers: dict[str, TaskHandler] = {}
+        self._held: list[tuple[str, str, str]] = []
         self._end: simpy.Event | None = None
         self._timeline: simpy.Process | None = None
         self._limit: simpy.Event | None = None
@@ -68,6 +70,13 @@ class Simulation:
         self.cosim = load_fidelity(spec.fidelity)(self)
 
     # -- set-up ----------------------------------------------------------------------------
+    def _not_placed(self, room: str, kind: str, reason: str) -> None:
+        """An item a room had no place for: an event (held until the run starts)."""
+        if self._end is None:
+            self._held.append((room, kind, reason))
+        else:
+            self.log.emit("clutter_skipped", room=room, item=kind, reason=reason)
+
     def _make_robot(self, member: MemberSpec) -> Robot:
         d = KIND_DEFAULTS[member.kind]
         height = member.height or d.height
@@ -204,6 +213,8 @@ class Simulation:
             self.env.process(scheduled(self, event))
         self._limit = self.env.timeout(spec.time_limit)
         self._end = simpy.AnyOf(self.env, [self.found, self._timeline, self._limit])
+        for held in self._held:
+            self._not_placed(*held)
         # The end stops env.run() itself: wrapping it in another condition would not do, as a
         # SimPy condition that fires strips the checks of the conditions nested in it.
         self._end.callbacks.append(simpy.core.StopSimulation.callback)
