@@ -40,6 +40,8 @@ class Simulation:
     def __init__(self, mission: Mission, *, out_dir: str | Path | None = None,
                  progress: Progress | None = None) -> None:
         spec = mission.spec
+        self._held: list[tuple[str, str, str]] = []
+        self._end: simpy.Event | None = None
         self.mission = mission
         self.world = mission.world
         self.env = simpy.Environment()
@@ -60,8 +62,6 @@ class Simulation:
         self._ids = itertools.count(1)
         self._started: dict[str, tuple[int, float]] = {}  # robot -> running task, its start
         self._handlers: dict[str, TaskHandler] = {}
-        self._held: list[tuple[str, str, str]] = []
-        self._end: simpy.Event | None = None
         self._timeline: simpy.Process | None = None
         self._limit: simpy.Event | None = None
         self._sinks: Any = None
