@@ -107,12 +107,12 @@ def go_to(ctx: Context, robot: Robot, goal_floor: tuple[float, ...]) -> ActionGe
 
 def search_path(ctx: Context, robot: Robot, room: Room, plan: FloatArray, label: str) -> ActionGen:
     """Go to the start of a coverage path ``plan`` (floor level) and follow it, sensing."""
+    sweep = at_height(robot, plan)
+    coverage = ctx.sensor.coverage(robot, sweep, room)  # furnishes the room before going in
     approach = route(ctx, robot, plan[0])
     if approach is None:
         return failed(f"no route for a {robot.kind} to room {room.id}")
     distance = yield from traverse(ctx, robot, approach, sense=False)
-    sweep = at_height(robot, plan)
-    coverage = ctx.sensor.coverage(robot, sweep, room)
     distance += yield from traverse(ctx, robot, sweep, sense=True)
     return result(TaskStatus.SUCCEEDED, f"{label} saw {coverage:.0%} of {room.id}",
                   distance=distance, coverage=coverage)

@@ -13,6 +13,7 @@ def move(ctx: Context, robot: Robot, task: Task) -> ActionGen:
     """Params: ``point`` = ``center`` (default) or ``door`` with a room; or ``x``, ``y``, ``z``."""
     room = room_of(ctx, task)
     if room is not None:
+        ctx.sensor.scene.clutter(room.id)  # its furniture is there before the robot is
         where = task.param("point", "center")
         goal = room.center if where == "center" else room.door_point("corridor")
     elif all(k in dict(task.params) for k in ("x", "y")):

@@ -24,10 +24,12 @@ import simpy
 from astralis_des.cosim import COSIMS
 from astralis_des.cosim.kinematic import MotionOutcome
 from astralis_des.kernel.robot import Motion, Robot
+from astralis_des.kernel.scene import Mover
 from astralis_des.physics.client import PhysicsClient
 from astralis_des.physics.drivers import DRIVERS, Driver
 from astralis_des.physics.hexacopter import write_urdf
 from astralis_des.sensing import GeometricSensor, Sighting
+from astralis_des.world.clutter import Clutter
 from astralis_des.world.geometry import FloatArray
 
 if TYPE_CHECKING:
@@ -84,35 +86,52 @@ class PhysicsCoSim:
             for rid, robot in sim.robots.items()}
         self.names = {d.body: rid for rid, d in self.drivers.items()}
         self.names.update({self.client.static: "wall", self.client.ground: "ground"})
+        self._scene = sim.scene
+        self.t = 0.0  # physics time: whole control periods
         self._add_scene(sim)
         self.site = sim.world.site
         self.active: dict[str, tuple[Robot, Track, simpy.Event]] = {}
         self.touching: set[tuple[str, str]] = set()
-        self.t = 0.0  # physics time: whole control periods
         self._wake: simpy.Event = self.env.event()
         self._next_log = 0.0
         self._ticks = 0
         self.env.process(self._stepper())
 
     def _add_scene(self, sim: Simulation) -> None:
-        """Furniture and still avatars as one static body; the target; movers kinematic."""
+        """The target and the movers now; each room's furniture (one static body) and its
+        patrolling avatars when the room is furnished, before any robot goes in."""
         scene = sim.scene
-        still = scene.static_bodies(sorted(sim.world.rooms))
-        if still:
-            body = self.client.add_boxes([p.box.lo for p in still], [p.box.hi for p in still])
-            self.names[body] = "furniture"
-        self.movers = [(m, self.client.add_box(m.position_at(0.0), m.size))
-                       for m in [*scene.movers, *scene.avatar_movers()]]
-        self.names.update({body: m.kind for m, body in self.movers})
+        self.movers: list[tuple[Mover, int]] = []
+        self.movers_time = 0.0  # the time the movers were last put at
+        self._add_movers([*scene.movers, *scene.avatar_movers()])
+        for room_id in sorted(scene._rooms):
+            self._furnish(room_id, scene.clutter(room_id), movers=False)
+        scene.listeners.append(self._furnish)
         target = sim.target
         if target.mover is None:
             w, d = (1.8, 0.6) if target.avatar.get("activity") == "laying" else (0.5, 0.5)
             body = self.client.add_box(target.start, (w, d, 2 * 0.5))
             self.names[body] = "target"
 
+    def _furnish(self, room_id: str, clutter: Clutter, movers: bool = True) -> None:
+        still = [p for p in clutter.placed if dict(p.attributes).get("activity") != "patrolling"]
+        if still:
+            body = self.client.add_boxes([p.box.lo for p in still], [p.box.hi for p in still])
+            self.names[body] = "furniture"
+        if movers:
+            self._add_movers(self._scene.avatar_movers([room_id]))
+
+    def _add_movers(self, movers: list[Mover]) -> None:
+        for mover in movers:
+            body = self.client.add_box(mover.position_at(self.t), mover.size)
+            self.movers.append((mover, body))
+            self.names[body] = mover.kind
+
     def _move_movers(self) -> None:
-        """Put each mover where it is at the end of the coming tick."""
+        """Put each mover where it is at the end of the coming tick. Done at the contact
+        checks' rate (30 Hz): a walker then jumps about 3 cm at a time."""
         reset, then = self.client.call, self.t + self.period
+        self.movers_time = then
         for mover, body in self.movers:
             reset("resetBasePositionAndOrientation", body, mover.position_at(then).tolist(),
                   [0.0, 0.0, 0.0, 1.0])
@@ -194,7 +213,7 @@ class PhysicsCoSim:
                         if (out := self._tick(rid, track, check)) is not None]
             if finished:
                 return finished
-            if self.movers:
+            if self.movers and check:
                 self._move_movers()
             self.client.step()
             self.t += self.period

@@ -87,6 +87,8 @@ class Scene:
         self.catalogue = catalogue
         self.enabled = clutter
         self.on_skipped = on_skipped  # told of each item a room had no place for
+        # told of each room when it is furnished (the physics adds its bodies then)
+        self.listeners: list[Callable[[str, Clutter], None]] = []
         self._order = {rid: i for i, rid in enumerate(sorted(world.rooms))}
         self._rooms: dict[str, Clutter] = {}
         self._reserved: dict[str, Box] = {}  # room -> the target's footprint, kept free
@@ -107,6 +109,8 @@ class Scene:
                 if self.on_skipped is not None:
                     for skipped in self._rooms[room_id].skipped:
                         self.on_skipped(*skipped)
+            for listener in self.listeners:
+                listener(room_id, self._rooms[room_id])
         return self._rooms[room_id]
 
     def _clear_target(self, room_id: str, placed: Clutter) -> Clutter:
@@ -135,15 +139,16 @@ class Scene:
         return [p for rid in room_ids for p in self.clutter(rid).placed
                 if dict(p.attributes).get("activity") != "patrolling"]
 
-    def avatar_movers(self) -> list[Mover]:
-        """Patrolling bystanders of the furnished rooms and a patrolling target, as movers."""
+    def avatar_movers(self, rooms: Iterable[str] | None = None) -> list[Mover]:
+        """Patrolling bystanders of the furnished rooms (or of ``rooms``), as movers, and a
+        patrolling target when no rooms are named."""
         found: list[Mover] = []
-        for rid in sorted(self._rooms):
-            for p in self._rooms[rid].placed:
-                if dict(p.attributes).get("activity") == "patrolling":
-                    found.append(self._patrol(f"avatar:{rid}:{len(found)}", rid, p.center,
-                                              p.size, p.attributes))
-        if self.target is not None and self.target.mover is not None:
+        for rid in sorted(self._rooms) if rooms is None else rooms:
+            patrols = [p for p in self.clutter(rid).placed
+                       if dict(p.attributes).get("activity") == "patrolling"]
+            found += [self._patrol(f"avatar:{rid}:{i}", rid, p.center, p.size, p.attributes)
+                      for i, p in enumerate(patrols)]
+        if rooms is None and self.target is not None and self.target.mover is not None:
             found.append(self.target.mover)
         return found
 
