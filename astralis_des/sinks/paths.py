@@ -8,6 +8,7 @@ WORLD_SOLIDS = "world/solids"
 WORLD_ROOMS = "world/rooms"
 WORLD_TARGET = "world/target"
 WORLD_FURNITURE = "world/furniture"
+WORLD_ROADS = "world/roads"
 MISSION_EVENTS = "mission/events"
 MISSION_ROUNDS = "mission/assignment"
 

@@ -139,6 +139,12 @@ def log_solids(rr: Any, rec: Any, world: World) -> None:
     colors = [SOLID_COLORS.get(s.kind, OBSTACLE_COLOR) for s in world.solids]
     rec.log(paths.WORLD_SOLIDS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
                                            colors=colors, fill_mode="solid"), static=True)
+    if world.surfaces:
+        lo = np.array([s.box.lo for s in world.surfaces])
+        hi = np.array([s.box.hi for s in world.surfaces])
+        rec.log(paths.WORLD_ROADS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
+                                              colors=[(60, 60, 65, 255)], fill_mode="solid"),
+                static=True)
 
 
 def log_rooms(rr: Any, rec: Any, world: World, states: Mapping[str, Any]) -> None:

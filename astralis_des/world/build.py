@@ -31,11 +31,22 @@ def build_world(spec: WorldSpec) -> World:
         sx, sy, sz = obstacle.size
         box = Box((cx - sx / 2, cy - sy / 2, 0.0), (cx + sx / 2, cy + sy / 2, sz))
         parts.solids.append(Solid(obstacle.kind, box, obstacle.kind))
+    roads = tuple(Solid("road", _road_box(r.start, r.end, r.width), "road") for r in spec.roads)
     return World(
         name=spec.name, site=spec.site.size, buildings=buildings, segments=parts.segments,
         rooms=parts.rooms, spaces=parts.spaces, solids=tuple(parts.solids),
         stairs_passable_by={b.id: tuple(b.stairs_passable_by) for b in spec.buildings},
+        surfaces=roads,
     )
+
+
+def _road_box(start: tuple[float, float], end: tuple[float, float], width: float) -> Box:
+    """An axis-aligned road (a road in any other direction gets its bounding box)."""
+    lo = (min(start[0], end[0]), min(start[1], end[1]))
+    hi = (max(start[0], end[0]), max(start[1], end[1]))
+    pad_x = width / 2 if hi[1] - lo[1] > hi[0] - lo[0] else 0.0
+    pad_y = width / 2 if pad_x == 0.0 else 0.0
+    return Box((lo[0] - pad_x, lo[1] - pad_y, 0.0), (hi[0] + pad_x, hi[1] + pad_y, 0.02))
 
 
 @lru_cache(maxsize=16)

@@ -108,6 +108,7 @@ class World:
     spaces: dict[str, Space]
     solids: tuple[Solid, ...]
     stairs_passable_by: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    surfaces: tuple[Solid, ...] = ()  # roads and such: drawn, walked on, never in the way
 
     @cached_property
     def solid_array(self) -> FloatArray:

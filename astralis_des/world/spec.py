@@ -62,6 +62,14 @@ class ObstacleSpec(Strict):
     size: Vec3 = Field(description="box extent x, y, z in metres")
 
 
+class RoadSpec(Strict):
+    """A straight stretch of road between two points: ground surface, not an obstacle."""
+
+    start: Vec2
+    end: Vec2
+    width: PositiveFloat = 7.0
+
+
 class SiteSpec(Strict):
     size: tuple[PositiveFloat, PositiveFloat] = Field(description="outdoor area, metres")
 
@@ -71,6 +79,7 @@ class WorldSpec(Strict):
     site: SiteSpec
     buildings: list[BuildingSpec] = Field(min_length=1)
     obstacles: list[ObstacleSpec] = Field(default_factory=list)
+    roads: list[RoadSpec] = Field(default_factory=list)
 
     @field_validator("buildings")
     @classmethod
