@@ -37,7 +37,8 @@ def route_to(sim: Simulation, robot: Any, room: str) -> Any:
     from astralis_des.actions.common import route
 
     return route(sim, robot, sim.world.rooms[room].door_point("corridor"))
-MISSION = Path(__file__).resolve().parents[1] / "missions" / "urban_search.yaml"
+ROOT = Path(__file__).resolve().parents[1]
+MISSION = ROOT / "missions" / "urban_search.yaml"
 
 
 @pytest.fixture(scope="module")
@@ -308,3 +309,29 @@ def test_with_changes_refuses_an_unknown_robot(mission: Mission) -> None:
         changed = mission.with_changes(timeline=[{"at": 10, "event": "fault",
                                                   "robot": "nobody"}])
         Simulation(changed)
+
+
+def test_rooms_a_kind_cannot_reach_are_excluded_edges(tmp_path: Path) -> None:
+    """With stairs the UGV cannot climb, it is never matched to an upper floor's room: the
+    round records that edge's cost as null (infinite) and leaves the UGV unassigned."""
+    text = (ROOT / "worlds" / "urban_default.yaml").read_text(encoding="utf-8")
+    text = text.replace("    segments:\n      - {side: north, rooms: 3}\n      - {side: south, "
+                        "rooms: 3}", "    stairs_passable_by: [uav, human]\n    segments:\n"
+                        "      - {side: north, rooms: 3}\n      - {side: south, rooms: 3}")
+    world = tmp_path / "no_ramp.yaml"
+    world.write_text(text, encoding="utf-8")
+    mission = load_mission(MISSION)
+    mission_text = MISSION.read_text(encoding="utf-8").replace(
+        "world: ../worlds/urban_default.yaml", f"world: {world}")
+    mission_file = tmp_path / "mission.yaml"
+    mission_file.write_text(mission_text + "target: {room: B.1.1.1}\n", encoding="utf-8")
+    result = Simulation(load_mission(mission_file).with_changes(time_limit=900)).run()
+    upper = [r for r in result.rounds if not r["segment"].startswith("A.1.")]
+    assert upper, "the search reached the upper floors"
+    for rnd in upper:
+        ugv = rnd["agents"].index("ugv1")
+        assert rnd["costs"][ugv] == [None] * len(rnd["rooms"])
+        assert "ugv1" in rnd["unassigned"]
+    lower = [r for r in result.rounds if r["segment"].startswith("A.1.")]
+    assert any(m["agent"] == "ugv1" for r in lower for m in r["matching"])
+    assert mission.spec.name == "urban_search"

@@ -38,6 +38,7 @@ class Assignment:
         return next((p.room for p in self.pairs if p.agent == agent), None)
 
 
+EXCLUDED = 1e9  # the cost a solver sees for an edge that does not exist
 Strategy = Callable[[Sequence[Agent], Sequence[RoomInfo], Weights], NDArray[np.float64]]
 STRATEGIES: Registry[str, Strategy] = Registry("assignment strategy")
 
@@ -58,14 +59,24 @@ def naive(agents: Sequence[Agent], rooms: Sequence[RoomInfo],
 
 def assign(agents: Sequence[Agent], rooms: Sequence[RoomInfo], weights: Weights, *,
            strategy: str = "mixed", solver: str = "scipy", high_risk: float = 0.5,
-           high_messiness: float = 0.5) -> Assignment:
-    """Match agents to rooms and pick each matched agent's action by Table IV."""
+           high_messiness: float = 0.5,
+           reachable: NDArray[np.bool_] | None = None) -> Assignment:
+    """Match agents to rooms and pick each matched agent's action by Table IV.
+
+    ``reachable[i, j]`` false excludes the edge: its cost is infinite, the matching avoids it,
+    and an agent left with only such edges stays unassigned (the room stays pending).
+    """
     costs = STRATEGIES.get(strategy)(agents, rooms, weights)
+    if reachable is not None:
+        costs = np.where(reachable, costs, np.inf)
+    finite = np.isfinite(costs)
+    # The solvers want finite costs: an excluded edge costs more than any full matching.
+    solvable = np.where(finite, costs, EXCLUDED)
     pairs = tuple(
         Pair(agents[i].id, rooms[j].id, float(costs[i, j]),
              table4_action(agents[i].kind, rooms[j].risk, rooms[j].messiness, high_risk,
                            high_messiness))
-        for i, j in match(costs, solver)
+        for i, j in match(solvable, solver) if finite[i, j]
     )
     matched = {p.agent for p in pairs}
     return Assignment(tuple(a.id for a in agents), tuple(r.id for r in rooms), costs, pairs,

@@ -158,13 +158,15 @@ class Simulation:
         infos = [RoomInfo(rid, self.world.rooms[rid].center, self.rooms[rid].risk,
                           self.rooms[rid].messiness) for rid in rooms]
         weights = Weights(cfg.weights.risk.model_dump(), cfg.weights.messiness.model_dump())
+        reachable = np.array([[self._reaches(robot, rid) for rid in rooms] for robot in robots])
         plan = assign(agents, infos, weights, strategy=cfg.strategy, solver=cfg.solver,
-                      high_risk=cfg.high_risk, high_messiness=cfg.high_messiness)
-        record = {
+                      high_risk=cfg.high_risk, high_messiness=cfg.high_messiness,
+                      reachable=reachable)
+        record: dict[str, Any] = {
             "round": len(self.rounds) + 1, "t": self.env.now, "segment": segment,
             "strategy": cfg.strategy, "agents": list(plan.agents), "rooms": list(plan.rooms),
             "risk": [i.risk for i in infos], "messiness": [i.messiness for i in infos],
-            "costs": plan.costs.tolist(),
+            "costs": [[c if np.isfinite(c) else None for c in row] for row in plan.costs.tolist()],
             "matching": [{"agent": p.agent, "room": p.room, "cost": p.cost, "action": p.action}
                          for p in plan.pairs],
             "unassigned": list(plan.unassigned),
@@ -172,6 +174,13 @@ class Simulation:
         self.rounds.append(record)
         self.log.emit("assignment", **{k: v for k, v in record.items() if k != "t"})
         return plan
+
+    def _reaches(self, robot: Robot, room_id: str) -> bool:
+        """Can this robot's kind get to the room from where it is (stairs, ramps, doors)?"""
+        here = robot.position(self.env.now).copy()
+        here[2] = self.world.floor_below(here)
+        return self.world.router.route(here, self.world.rooms[room_id].door_point("corridor"),
+                                       robot.kind) is not None
 
     # -- detection -------------------------------------------------------------------------
     def report_detection(self, robot: Robot, sighting: Sighting) -> None:
