@@ -36,7 +36,7 @@ def flown_in(result: RunResult, robot: str, seconds: float) -> float:
 def route_to(sim: Simulation, robot: Any, room: str) -> Any:
     from astralis_des.actions.common import route
 
-    return route(sim, robot, sim.world.rooms[room].door_point("corridor"))
+    return route(sim, robot, sim.world.rooms[room].door_point("corridor")).points
 ROOT = Path(__file__).resolve().parents[1]
 MISSION = ROOT / "missions" / "urban_search.yaml"
 

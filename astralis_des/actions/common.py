@@ -11,6 +11,7 @@ import simpy
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kernel.tasks import ActionResult, Task, TaskStatus
 from astralis_des.kinds import TARGET_HEIGHT
+from astralis_des.planning.navigator import Navigator, Route
 from astralis_des.sensing import GeometricSensor, Sighting
 from astralis_des.world.geometry import FloatArray
 from astralis_des.world.model import Room, World
@@ -24,6 +25,7 @@ class CoSim(Protocol):
     def watch(self, robot: Robot, motion: Motion, sensor: GeometricSensor,
               done: simpy.Event) -> simpy.Event: ...
     def dwell(self, robot: Robot, seconds: float) -> simpy.Event: ...
+    def face(self, robot: Robot, heading: float) -> simpy.Event: ...
     def halt(self, robot: Robot) -> None: ...
 
 
@@ -38,6 +40,7 @@ class Context(Protocol):
     world: World
     cosim: CoSim
     sensor: GeometricSensor
+    navigator: Navigator
 
     def report_detection(self, robot: Robot, sighting: Sighting) -> None: ...
 
@@ -61,12 +64,11 @@ def at_height(robot: Robot, floor_points: FloatArray) -> FloatArray:
 
 
 def route(ctx: Context, robot: Robot,
-          goal_floor: FloatArray | tuple[float, ...]) -> FloatArray | None:
+          goal_floor: FloatArray | tuple[float, ...]) -> Route:
     """Route from where the robot is to a floor-level goal, at the robot's sensor height."""
     here = robot.position(ctx.env.now).copy()
     here[2] = ctx.world.floor_below(here)  # where it stands, or the floor it flies over
-    pts = ctx.world.router.route(here, goal_floor, robot.kind)
-    return None if pts is None else at_height(robot, pts)
+    return ctx.navigator.route(robot, here, np.asarray(goal_floor, dtype=float))
 
 
 def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> StepGen:
@@ -98,10 +100,10 @@ def dwell(ctx: Context, robot: Robot, seconds: float) -> StepGen:
 
 
 def go_to(ctx: Context, robot: Robot, goal_floor: tuple[float, ...]) -> ActionGen:
-    points = route(ctx, robot, goal_floor)
-    if points is None:
-        return failed(f"no route for a {robot.kind} to {tuple(round(v, 2) for v in goal_floor)}")
-    distance = yield from traverse(ctx, robot, points, sense=False)
+    way = route(ctx, robot, goal_floor)
+    if way.points is None:
+        return failed(way.reason)
+    distance = yield from traverse(ctx, robot, way.points, sense=False)
     return result(TaskStatus.SUCCEEDED, "arrived", distance=distance)
 
 
@@ -109,10 +111,18 @@ def search_path(ctx: Context, robot: Robot, room: Room, plan: FloatArray, label:
     """Go to the start of a coverage path ``plan`` (floor level) and follow it, sensing."""
     sweep = at_height(robot, plan)
     coverage = ctx.sensor.coverage(robot, sweep, room)  # furnishes the room before going in
-    approach = route(ctx, robot, plan[0])
-    if approach is None:
-        return failed(f"no route for a {robot.kind} to room {room.id}")
-    distance = yield from traverse(ctx, robot, approach, sense=False)
+    sweep = ctx.navigator.usable(robot, sweep)  # where the body fits among the furniture
+    if len(sweep) == 0:
+        return failed(f"{label}: no point of the pattern is free in {room.id}")
+    approach = route(ctx, robot, sweep[0] - np.array([0.0, 0.0, robot.height]))
+    if approach.points is None:
+        return failed(approach.reason)
+    distance = yield from traverse(ctx, robot, approach.points, sense=False)
+    refined = ctx.navigator.refine(robot, sweep) if ctx.navigator.method == "map" else None
+    if refined is not None:
+        if refined.points is None:
+            return failed(refined.reason)
+        sweep = refined.points
     distance += yield from traverse(ctx, robot, sweep, sense=True)
     return result(TaskStatus.SUCCEEDED, f"{label} saw {coverage:.0%} of {room.id}",
                   distance=distance, coverage=coverage)

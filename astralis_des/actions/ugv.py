@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from astralis_des.actions import ACTIONS
@@ -18,6 +20,8 @@ from astralis_des.actions.common import (
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task, TaskStatus
 
+SNEAK_OFFSET = 0.5  # m in front of the wall's face: where the UGV's body clears the jambs
+
 
 @ACTIONS.register(("ugv", "sneak_peek"))
 def sneak_peek(ctx: Context, robot: Robot, task: Task) -> ActionGen:
@@ -25,11 +29,13 @@ def sneak_peek(ctx: Context, robot: Robot, task: Task) -> ActionGen:
     room = room_of(ctx, task)
     if room is None:
         return failed("sneak_peek needs a room")
-    points = route(ctx, robot, room.door_point("corridor", offset=0.15))
-    if points is None:
-        return failed(f"no route for a ugv to the door of {room.id}")
-    distance = yield from traverse(ctx, robot, points, sense=False)
+    way = route(ctx, robot, room.door_point("corridor", offset=SNEAK_OFFSET))
+    if way.points is None:
+        return failed(way.reason)
+    distance = yield from traverse(ctx, robot, way.points, sense=False)
     here = robot.position(ctx.env.now)
+    into = math.atan2(room.center[1] - here[1], room.center[0] - here[0])
+    yield ctx.cosim.face(robot, into)  # turn the camera into the room
     coverage = ctx.sensor.coverage(robot, here[None, :], room)
     yield from dwell(ctx, robot, float(task.param("dwell", 5.0)))
     return result(TaskStatus.SUCCEEDED, f"sneak peek saw {coverage:.0%} of {room.id}",
@@ -53,10 +59,10 @@ def observe_corridor(ctx: Context, robot: Robot, task: Task) -> ActionGen:
     here = robot.position(ctx.env.now)
     if abs(here[0] - x1) < abs(here[0] - x0):
         ends.reverse()
-    points = route(ctx, robot, tuple(ends[0]))
-    if points is None:
-        return failed(f"no route for a ugv to the corridor of {room.id}")
-    distance = yield from traverse(ctx, robot, points, sense=False)
+    way = route(ctx, robot, tuple(ends[0]))
+    if way.points is None:
+        return failed(way.reason)
+    distance = yield from traverse(ctx, robot, way.points, sense=False)
     drive = np.array(ends) + np.array([0.0, 0.0, robot.height])
     coverage = ctx.sensor.coverage(robot, drive, room)
     distance += yield from traverse(ctx, robot, drive, sense=True)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -41,6 +42,14 @@ class KinematicCoSim:
         """An event that succeeds with the first sighting along the motion (never if none)."""
         hit = sensor.first_sighting(robot, motion)
         return self.env.timeout(hit.t, value=hit) if hit is not None else self.env.event()
+
+    def face(self, robot: Robot, heading: float) -> simpy.Event:
+        """Turn on the spot to ``heading`` (at once for a robot that needs not turn)."""
+        robot.halt(self.env.now)
+        turn = abs(math.remainder(heading - robot.heading, math.tau))
+        robot.heading = heading
+        seconds = turn / robot.turn_rate if robot.turn_rate else 0.0
+        return self.env.timeout(seconds, value=ARRIVED)
 
     def dwell(self, robot: Robot, seconds: float) -> simpy.Event:
         robot.halt(self.env.now)

@@ -152,6 +152,26 @@ class PhysicsCoSim:
             self._wake.succeed()
         return done
 
+    def face(self, robot: Robot, heading: float) -> simpy.Event:
+        """Turn on the spot to ``heading``: the UGV turns its body; others look at once."""
+        driver = self.drivers[robot.id]
+        if not hasattr(driver, "turn_to"):
+            self.halt(robot)
+            robot.heading = heading
+            return self.env.timeout(0.0, value=MotionOutcome(True, "arrived"))
+        self.halt(robot)
+        driver.turn_to(heading)
+        track = Track(driver, self.env.now)
+        track.sample(self.env.now)
+        track.checkpoint = (self.env.now, track.points[-1])
+        robot.begin(track, self.env.now)  # type: ignore[arg-type]
+        done = self.env.event()
+        self.active[robot.id] = (robot, track, done)
+        robot.heading = heading
+        if not self._wake.triggered:
+            self._wake.succeed()
+        return done
+
     def dwell(self, robot: Robot, seconds: float) -> simpy.Event:
         self.halt(robot)
         return self.env.timeout(seconds)
@@ -240,7 +260,8 @@ class PhysicsCoSim:
                 and -1.0 <= here[2] <= 200.0):
             return MotionOutcome(False, "left the world")
         since, where = track.checkpoint or (self.t, here)
-        if float(np.linalg.norm(here - where)) > PROGRESS:
+        if float(np.linalg.norm(here - where)) > PROGRESS or getattr(track.driver, "turning",
+                                                                     False):
             track.checkpoint = (self.t, here)
         elif self.t - since > self.spec.stuck_timeout:
             return MotionOutcome(False, f"stuck: no progress for {self.spec.stuck_timeout:g} s")

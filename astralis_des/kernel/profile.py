@@ -17,6 +17,7 @@ from astralis_des.world.geometry import FloatArray
 
 MIN_CORNER = 0.1  # share of the cruise speed kept through a reversal
 STOP_ANGLE = math.radians(10)  # a non-holonomic robot stops to turn beyond this
+MIN_TURN_LEG = 0.25  # m: a shorter leg is a nudge, not worth turning on the spot for
 
 
 @dataclass(frozen=True)
@@ -77,7 +78,7 @@ def build(points: FloatArray, speed: float, accel: float | None = None,
     if turn_rate is not None:
         previous = heading
         for i in range(n):
-            if flat[i]:
+            if flat[i] and lengths[i] >= MIN_TURN_LEG:
                 turns[i] = abs(math.remainder(headings[i] - previous, math.tau))
                 previous = headings[i]
         turns[turns < STOP_ANGLE] = 0.0

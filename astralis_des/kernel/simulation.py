@@ -27,6 +27,7 @@ from astralis_des.kernel.world_state import draw_rooms, draw_target
 from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.mission.loader import Mission
 from astralis_des.mission.spec import MemberSpec
+from astralis_des.planning.navigator import Navigator
 from astralis_des.sensing import GeometricSensor, Sighting
 
 log = logging.getLogger(__name__)
@@ -67,6 +68,7 @@ class Simulation:
         self._sinks: Any = None
         self._wall0 = time.perf_counter()
         self.robots = {m.id: self._make_robot(m) for m in spec.team}
+        self.navigator = Navigator(self)
         self.cosim = load_fidelity(spec.fidelity)(self)
 
     # -- set-up ----------------------------------------------------------------------------

@@ -185,6 +185,20 @@ class PhysicsSpec(Strict):
         return 1.0 / self.rate
 
 
+class PlanningSpec(Strict):
+    """How robots find their way: ``graph`` (the rooms-and-doors graph, straight legs),
+    ``map`` (the graph's way, with every blocked leg planned around furniture on the
+    occupancy map), or ``auto`` (graph in kinematic fidelity, map in physics)."""
+
+    method: Literal["auto", "graph", "map"] = "auto"
+    budget: NonNegativeFloat = Field(0.2, description="s of planning allowed per leg")
+    uav_planner: Literal["rrtconnect", "informed_rrtstar"] = "rrtconnect"
+    ugv_space: Literal["reedsshepp", "dubins"] = "reedsshepp"
+    turning_radius: PositiveFloat = Field(0.4, description="m, the UGV's tightest turn")
+    margin: NonNegativeFloat = Field(
+        0.05, description="m of clearance beyond the body (a 1 m door leaves a UAV 0.1 m)")
+
+
 class SceneSpec(Strict):
     """What the mission adds to its world: furniture and avatars by each room's messiness
     (from the catalogue), and moving obstacles wandering in the corridors."""
@@ -214,6 +228,7 @@ class MissionSpec(Strict):
     assignment: AssignmentSpec = Field(default_factory=AssignmentSpec)
     timeline: list[TimelineEvent] = Field(default_factory=list)
     scene: SceneSpec = Field(default_factory=SceneSpec)
+    planning: PlanningSpec = Field(default_factory=PlanningSpec)
     physics: PhysicsSpec = Field(default_factory=PhysicsSpec)
     outputs: OutputsSpec = Field(default_factory=OutputsSpec)
 

@@ -25,6 +25,7 @@ from astralis_des.world.geometry import FloatArray
 
 ARRIVED = 0.2  # m from the end of its path, nearly still: a UAV has arrived
 UGV_RATE = 40  # Hz: pure pursuit updates (when the control rate is a multiple of it)
+FACING = 0.08  # rad: close enough to the heading asked for
 LIFT_RISE = 0.3  # m: a leg climbing more than this is ridden on the stairwell's vehicle lift
 
 
@@ -99,8 +100,18 @@ class UgvDriver:
         self.lift: tuple[float, FloatArray] | None = None
         self.every = max(1, round(spec.control_rate / UGV_RATE))
         self._ticks = 0
+        self.turning = False
+        self.heading = 0.0
+
+    def turn_to(self, heading: float) -> None:
+        """Turn on the spot until the body faces ``heading``."""
+        self.legs = []
+        self.lift = None
+        self.turning = True
+        self.heading = heading
 
     def start(self, motion: Motion, t: float) -> None:
+        self.turning = False
         floor = motion.points - np.array([0.0, 0.0, self.height])
         legs: list[tuple[bool, FloatArray]] = []
         run = [floor[0]]
@@ -130,6 +141,14 @@ class UgvDriver:
             self.husky.follow(points, self.speed)
 
     def tick(self, t: float) -> str | None:
+        if self.turning:
+            error = math.remainder(self.heading - self.husky.pose()[3], math.tau)
+            if abs(error) < FACING:
+                self.husky.drive(0.0, 0.0)
+                self.turning = False
+                return "arrived"
+            self.husky.drive(0.0, math.copysign(min(1.0, 2.0 * abs(error) + 0.3), error))
+            return None
         if self.lift is not None:
             t0, (a, b) = self.lift
             share = min((t - t0) * self.speed / max(float(np.linalg.norm(b - a)), 1e-9), 1.0)

@@ -1,0 +1,196 @@
+"""Routes for one simulation: the room graph finds the way (doors, corridors, stairwells), and
+in ``map`` mode every leg a straight line cannot take is planned around what stands in it:
+OMPL in 3-D for a UAV, OMPL in SE2 (Reeds-Shepp) for the UGV, A* on the floor for a walker.
+
+``graph`` mode (the kinematic default) keeps the graph's straight legs: thousands of missions
+a minute. ``map`` mode (the physics default) follows each room's real furniture.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from astralis_des.errors import InputError
+from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
+
+if TYPE_CHECKING:
+    from astralis_des.kernel.robot import Robot
+    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.planning.occupancy import GridMap, VoxelMap
+
+BODY_RADIUS = {"uav": 0.3, "ugv": 0.35, "human": 0.25}  # m, a disc around the body's centre
+WINDOW = 3.0  # m around a leg that its planner may use
+CELL = 0.1  # m, walkers' floor grid
+
+
+@dataclass(frozen=True)
+class Route:
+    points: FloatArray | None  # at the robot's sensor height; None when there is none
+    reason: str = ""
+
+
+class Navigator:
+    def __init__(self, sim: Simulation) -> None:
+        spec = sim.mission.spec
+        self.world, self.scene, self.cfg = sim.world, sim.scene, spec.planning
+        method = self.cfg.method
+        self.method = method if method != "auto" else (
+            "map" if spec.fidelity == "physics" else "graph")
+        self.seed = spec.seed
+        self.seconds = 0.0  # wall time spent planning
+        self.plans = 0
+        self._counter = itertools.count()
+        self._map: VoxelMap | None = None
+
+    # -- the way ---------------------------------------------------------------------------
+    def route(self, robot: Robot, start: FloatArray, goal: FloatArray) -> Route:
+        """From ``start`` to ``goal`` (both at floor level) for this robot."""
+        t0 = time.perf_counter()
+        try:
+            try:
+                way = self.world.router.route(start, goal, robot.kind)
+            except InputError as exc:  # a goal in a wall or off the site, asked at run time
+                return Route(None, exc.message)
+            if way is None:
+                return Route(None, f"no way for a {robot.kind} to there")
+            points = way + np.array([0.0, 0.0, robot.height])
+            if self.method == "graph":
+                return Route(points)
+            return self.refine(robot, points)
+        finally:
+            self.seconds += time.perf_counter() - t0
+
+    def refine(self, robot: Robot, points: FloatArray) -> Route:
+        """Replace each leg a straight line cannot take by a planned detour."""
+        radius = BODY_RADIUS[robot.kind] + self.cfg.margin
+        out = [points[0]]
+        for a, b in itertools.pairwise(points):
+            if float(np.linalg.norm(b - a)) < 1e-9 or self._leg_free(robot, a, b, radius):
+                out.append(b)
+                continue
+            detour, reason = self._plan_leg(robot, a, b, radius)
+            if detour is None:
+                where = ", ".join(f"{v:.1f}" for v in b)
+                return Route(None, f"no path to [{where}]: {reason}")
+            out.extend(detour[1:])
+        return Route(np.array(out))
+
+    def usable(self, robot: Robot, points: FloatArray) -> FloatArray:
+        """The points of a coverage path the robot's body fits at (the others dropped)."""
+        if self.method == "graph":
+            return points
+        ok = self._valid(robot, points, BODY_RADIUS[robot.kind] + self.cfg.margin)
+        return points[ok] if ok.any() else points[:0]
+
+    # -- what is in the way ----------------------------------------------------------------
+    @property
+    def map(self) -> VoxelMap:
+        if self._map is None:
+            from astralis_des.planning.occupancy import world_map
+
+            self._map = world_map(self.world)
+        return self._map
+
+    def _furniture(self, lo: FloatArray, hi: FloatArray) -> FloatArray:
+        """Boxes of still furniture and avatars in the rooms overlapping ``[lo, hi]``."""
+        rooms = [rid for rid, room in self.world.rooms.items()
+                 if np.all(np.asarray(room.box.lo) <= hi) and
+                 np.all(np.asarray(room.box.hi) >= lo)]
+        return boxes_array([p.box for p in self.scene.static_bodies(rooms)])
+
+    def _valid(self, robot: Robot, points: FloatArray, radius: float) -> np.ndarray:
+        pts = np.atleast_2d(points)
+        boxes = self._furniture(pts.min(axis=0) - radius, pts.max(axis=0) + radius)
+        return self._checker(boxes, radius)(pts)
+
+    def _checker(self, boxes: FloatArray, radius: float):  # type: ignore[no-untyped-def]
+        """A validity test for many states: the map's clearance, and the furniture ``boxes``
+        grown by ``radius`` (gathered once, not per state: a planner asks thousands)."""
+        voxels = self.map
+        grown_lo, grown_hi = boxes[:, 0] - radius, boxes[:, 1] + radius
+
+        def valid(points: FloatArray) -> np.ndarray:
+            pts = np.atleast_2d(points)
+            ok = voxels.free(pts, radius)
+            if len(grown_lo) and ok.any():
+                inside = np.all((pts[:, None, :] >= grown_lo[None]) &
+                                (pts[:, None, :] <= grown_hi[None]), axis=2).any(axis=1)
+                ok &= ~inside
+            return np.asarray(ok)
+
+        return valid
+
+    def _leg_free(self, robot: Robot, a: FloatArray, b: FloatArray, radius: float) -> bool:
+        """Is the straight leg clear of every box grown by ``radius``? Boxes, not the map: most
+        legs are clear, and the map is then never needed (it is built for planning only)."""
+        a, b = a.copy(), b.copy()
+        if robot.kind != "uav":  # a ground body stands on its floor: test at its middle
+            a[2] = b[2] = self.world.floor_below(a) + 0.4
+        lo, hi = np.minimum(a, b) - radius, np.maximum(a, b) + radius
+        boxes = np.concatenate([self.world.solid_array, self._furniture(lo, hi)])
+        boxes = boxes[np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1)]
+        grown = np.stack([boxes[:, 0] - radius, boxes[:, 1] + radius], axis=1)
+        return not bool(segments_hit_boxes(a[None, :], b[None, :], grown)[0])
+
+    # -- planning a leg --------------------------------------------------------------------
+    def _plan_leg(self, robot: Robot, a: FloatArray, b: FloatArray,
+                  radius: float) -> tuple[FloatArray | None, str]:
+        self.plans += 1
+        seed = (self.seed * 1_000_003 + next(self._counter)) % (2**31)
+        lo = np.minimum(a, b) - WINDOW
+        hi = np.maximum(a, b) + WINDOW
+        budget = self.cfg.budget
+        if robot.kind == "uav":
+            from astralis_des.planning.ompl_adapter import plan_3d
+
+            lo[2], hi[2] = min(a[2], b[2]) - 1.0, max(a[2], b[2]) + 1.0
+            valid = self._checker(self._furniture(lo, hi), radius)
+            plan = plan_3d(valid, lo, hi, a, b,
+                           budget=budget, planner=self.cfg.uav_planner, seed=seed,
+                           resolution=0.1)
+            return (plan.path if plan.ok else None), plan.reason
+        floor = self.world.floor_below(a)
+        grid = self._floor_grid(lo[:2], hi[:2], floor)
+        if robot.kind == "ugv":
+            from astralis_des.planning.ompl_adapter import plan_se2
+
+            heading = math.atan2(b[1] - a[1], b[0] - a[0])
+            start = np.array([a[0], a[1], heading])
+            goal = np.array([b[0], b[1], heading])
+            plan = plan_se2(lambda s: grid.free(s[:, :2], radius), lo[:2], hi[:2], start, goal,
+                            turning_radius=self.cfg.turning_radius, budget=budget,
+                            space=self.cfg.ugv_space, seed=seed, resolution=0.05)
+            if not plan.ok or plan.path is None:
+                return None, plan.reason
+            xy = plan.path[:, :2]
+        else:
+            from astralis_des.planning.grid import plan_grid
+
+            found, reason = plan_grid(grid, a, b, radius, budget=budget)
+            if found is None:
+                return None, reason
+            xy = found
+        return np.column_stack([xy, np.full(len(xy), a[2])]), ""
+
+    def _floor_grid(self, lo: FloatArray, hi: FloatArray, floor: float) -> GridMap:
+        """What stands on the floor (walls, furniture, avatars) between ``lo`` and ``hi``."""
+        from astralis_des.planning.occupancy import GridMap
+
+        shape = np.maximum(np.ceil((hi - lo) / CELL).astype(int), 1)
+        centers = lo + (np.indices(shape).reshape(2, -1).T + 0.5) * CELL
+        occupied = np.zeros(len(centers), dtype=bool)
+        z_lo, z_hi = floor + 0.05, floor + 1.8
+        solids = self.world.solid_array
+        boxes = np.concatenate([solids, self._furniture(np.array([*lo, z_lo]),
+                                                        np.array([*hi, z_hi]))])
+        tall = (boxes[:, 0, 2] < z_hi) & (boxes[:, 1, 2] > z_lo)
+        for box in boxes[tall]:
+            occupied |= np.all((centers >= box[0, :2] - CELL / 2) &
+                               (centers <= box[1, :2] + CELL / 2), axis=1)
+        return GridMap.from_occupancy(occupied.reshape(tuple(shape)), lo, CELL)

@@ -1,0 +1,258 @@
+"""Occupancy of a world as a voxel map with a distance field, and 2-D slices of it.
+
+A voxel is occupied when it overlaps a solid box, so a 0.2 m wall stays a whole wall at any
+resolution. Cell ``(i, j, k)`` spans ``origin + (i, j, k) * resolution`` to one resolution
+further. ``distance`` is the Euclidean distance in metres from a cell's centre to the nearest
+occupied cell's centre: what ``scipy.ndimage.distance_transform_edt(~occupied,
+sampling=resolution)`` gives (0 on occupied cells, inf when nothing is occupied).
+
+The 3-D field is found from the boxes rather than by scipy, which takes 18 s for the 62 M voxels
+of the default world. A box's occupied cells are a product of three index ranges, so the
+distance to it is separable, and the distance to all boxes is the minimum over them. Each box
+is swept only over the cells it could be nearest to: closer than a box covering the whole map
+(the ground) is, layer by layer.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any, TypeVar
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import ndimage
+
+from astralis_des.world.geometry import FloatArray
+from astralis_des.world.model import World
+
+BoolArray = NDArray[np.bool_]
+IntArray = NDArray[np.intp]
+A = TypeVar("A", bound=NDArray[Any])
+
+GROUND_DEPTH = 0.4  # m of solid ground below z = 0
+_EPS = 1e-6  # in cells: a box that only touches a cell's face does not occupy it
+_TIE = 1e-5  # m: a clearance equal to the radius is not free, however float32 rounds it
+
+
+@dataclass(frozen=True, eq=False)
+class GridMap:
+    """A 2-D occupancy grid and its distance field, indexed ``[i, j]`` like the voxel map."""
+
+    origin: FloatArray  # (2,) corner of cell (0, 0)
+    resolution: float
+    occupied: BoolArray  # (nx, ny)
+    distance: NDArray[np.float32]  # (nx, ny) metres to the nearest occupied cell's centre
+
+    @classmethod
+    def from_occupancy(cls, occupied: BoolArray, origin: ArrayLike,
+                       resolution: float) -> GridMap:
+        occupied = np.array(occupied, dtype=bool)  # a copy: it is made read-only
+        return cls(_frozen(np.array(origin, dtype=float)), resolution, _frozen(occupied),
+                   _frozen(_edt(occupied, resolution)))
+
+    def cell_of(self, points: ArrayLike) -> IntArray:
+        """``(N, 2)`` indices of the cells holding ``points`` (possibly outside the grid)."""
+        return _cell_of(points, self.origin, self.resolution)
+
+    def center_of(self, cells: ArrayLike) -> FloatArray:
+        return _center_of(cells, self.origin, self.resolution)
+
+    def clearance(self, points: ArrayLike) -> FloatArray:
+        """``(N,)`` distance field at each point's cell; 0 outside the grid."""
+        return self._field.at(self.cell_of(points))
+
+    @cached_property
+    def _field(self) -> _Field:
+        return _Field(self.distance)
+
+    def free(self, points: ArrayLike, radius: float) -> BoolArray:
+        """``(N,)``: is each point's clearance more than ``radius``? (Equal is not.)"""
+        return self.clearance(points) > radius + _TIE
+
+
+@dataclass(frozen=True, eq=False)
+class VoxelMap:
+    """A 3-D occupancy grid and its distance field; arrays are read-only and may be shared."""
+
+    origin: FloatArray  # (3,) corner of voxel (0, 0, 0)
+    resolution: float
+    occupied: BoolArray  # (nx, ny, nz)
+    distance: NDArray[np.float32]  # (nx, ny, nz) metres to the nearest occupied voxel's centre
+
+    def cell_of(self, points: ArrayLike) -> IntArray:
+        """``(N, 3)`` indices of the voxels holding ``points`` (possibly outside the map)."""
+        return _cell_of(points, self.origin, self.resolution)
+
+    def center_of(self, cells: ArrayLike) -> FloatArray:
+        return _center_of(cells, self.origin, self.resolution)
+
+    def clearance(self, points: ArrayLike) -> FloatArray:
+        """``(N,)`` distance field at each point's voxel; 0 outside the map."""
+        return self._field.at(self.cell_of(points))
+
+    @cached_property
+    def _field(self) -> _Field:
+        return _Field(self.distance)
+
+    def free(self, points: ArrayLike, radius: float) -> BoolArray:
+        """``(N,)``: is each point's clearance more than ``radius``? (Equal is not.)"""
+        return self.clearance(points) > radius + _TIE
+
+    def segment_free(self, p0: ArrayLike, p1: ArrayLike, radius: float) -> bool:
+        """Is every point of the segment, sampled every half voxel, free for ``radius``?"""
+        return self.path_free(np.array([p0, p1], dtype=float), radius)
+
+    def path_free(self, points: ArrayLike, radius: float, step: float | None = None) -> bool:
+        """Is every point of the polyline, sampled every ``step`` metres (by default half a
+        voxel), free for ``radius``?"""
+        dense = densify(points, step or self.resolution / 2)
+        return bool(self.free(dense, radius).all())
+
+    def slice_2d(self, z_lo: float, z_hi: float) -> GridMap:
+        """Cells occupied by any voxel overlapping the heights ``z_lo`` to ``z_hi``."""
+        nz = self.occupied.shape[2]
+        k0 = math.floor((z_lo - self.origin[2]) / self.resolution + _EPS)
+        k1 = math.ceil((z_hi - self.origin[2]) / self.resolution - _EPS)
+        k0 = min(max(k0, 0), nz - 1)
+        k1 = min(max(k1, k0 + 1), nz)
+        occupied = np.asarray(self.occupied[:, :, k0:k1].any(axis=2))
+        return GridMap.from_occupancy(occupied, self.origin[:2], self.resolution)
+
+
+def densify(points: ArrayLike, step: float) -> FloatArray:
+    """A polyline's vertices with points between them, consecutive points at most ``step`` apart."""
+    p = np.asarray(points, dtype=float)
+    if len(p) < 2:
+        return p.copy()
+    seg = p[1:] - p[:-1]
+    count = np.maximum(np.ceil(np.linalg.norm(seg, axis=1) / step - 1e-9), 1).astype(np.int64)
+    which = np.repeat(np.arange(len(seg)), count)
+    t = (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)) / count[which]
+    return np.vstack([p[which] + t[:, None] * seg[which], p[-1:]])
+
+
+def from_boxes(boxes: ArrayLike, lo: ArrayLike, hi: ArrayLike,
+               resolution: float = 0.2) -> VoxelMap:
+    """Rasterise ``(K, 2, 3)`` box corners over ``lo`` to ``hi``; beyond it counts as free."""
+    lo_ = np.asarray(lo, dtype=float)
+    span = (np.asarray(hi, dtype=float) - lo_) / resolution
+    nx, ny, nz = (int(n) for n in np.maximum(np.ceil(span - _EPS), 1))
+    corners = np.asarray(boxes, dtype=float).reshape(-1, 2, 3)
+    first = np.floor((corners[:, 0] - lo_) / resolution + _EPS).astype(np.int64)
+    stop = np.ceil((corners[:, 1] - lo_) / resolution - _EPS).astype(np.int64)
+    first, stop = np.clip(first, 0, (nx, ny, nz)), np.clip(stop, 0, (nx, ny, nz))
+    keep = np.all(stop > first, axis=1)
+    d2 = _squared_distances(first[keep], stop[keep], (nx, ny, nz))
+    distance = np.sqrt(d2, dtype=np.float32)
+    distance *= np.float32(resolution)
+    if not keep.any():
+        distance[:] = np.inf
+    # Computed layer-major (z, x, y) so each layer is contiguous; exposed as (x, y, z) views.
+    occupied = (d2 == 0).transpose(1, 2, 0)
+    return VoxelMap(_frozen(lo_), resolution, _frozen(occupied),
+                    _frozen(distance.transpose(1, 2, 0)))
+
+
+def world_map(world: World, extra: ArrayLike | None = None, resolution: float = 0.2,
+              margin: float = 2.0) -> VoxelMap:
+    """The world's solids, the ground and ``extra`` boxes over the site, up to ``margin`` above
+    the tallest of them.
+
+    Without ``extra`` the map depends on the world alone: it is built once per world and kept.
+    """
+    extra_boxes = np.zeros((0, 2, 3)) if extra is None else np.asarray(extra, dtype=float)
+    if len(extra_boxes):
+        return _build_world_map(world, extra_boxes.reshape(-1, 2, 3), resolution, margin)
+    cache: dict[tuple[float, float], VoxelMap] = world.__dict__.setdefault("_voxel_map", {})
+    key = (resolution, margin)
+    if key not in cache:
+        cache[key] = _build_world_map(world, extra_boxes, resolution, margin)
+    return cache[key]
+
+
+def _build_world_map(world: World, extra: FloatArray, resolution: float,
+                     margin: float) -> VoxelMap:
+    sx, sy = world.site
+    ground = np.array([[[0.0, 0.0, -GROUND_DEPTH], [sx, sy, 0.0]]])
+    boxes = np.concatenate([world.solid_array.reshape(-1, 2, 3), extra, ground])
+    top = float(boxes[:, 1, 2].max()) + margin
+    return from_boxes(boxes, (0.0, 0.0, -GROUND_DEPTH), (sx, sy, top), resolution)
+
+
+def _squared_distances(first: IntArray, stop: IntArray,
+                       shape: tuple[int, int, int]) -> NDArray[np.unsignedinteger]:
+    """``(nz, nx, ny)`` squared distance, in cells, to the nearest cell of any box.
+
+    Box ``b`` occupies cells ``first[b] <= index < stop[b]``.
+    """
+    nx, ny, nz = shape
+    layers = np.arange(nz)
+    gap_z = _gaps(first[:, 2, None], stop[:, 2, None], layers)  # (K, nz)
+    covers = np.all(first[:, :2] == 0, axis=1) & np.all(stop[:, :2] == (nx, ny), axis=1)
+    # No cell is farther from its nearest box than from a box covering every column.
+    reach = gap_z[covers].min(axis=0) if covers.any() else \
+        np.full(nz, math.ceil(math.hypot(nx, ny, nz)))
+    dtype = np.uint16 if 3 * int(reach.max()) ** 2 < np.iinfo(np.uint16).max else np.uint32
+    d2 = np.full((nz, nx, ny), np.iinfo(dtype).max, dtype)
+    ix, iy = np.arange(nx), np.arange(ny)
+    for (i0, j0, _), (i1, j1, _), gz in zip(first, stop, gap_z, strict=True):
+        for k in np.flatnonzero(gz <= reach):
+            w = math.isqrt(int(reach[k]) ** 2 - int(gz[k]) ** 2)
+            xa, xb, ya, yb = max(i0 - w, 0), min(i1 + w, nx), max(j0 - w, 0), min(j1 + w, ny)
+            gx: NDArray[Any] = _gaps(i0, i1, ix[xa:xb]).astype(dtype)
+            gy: NDArray[Any] = _gaps(j0, j1, iy[ya:yb]).astype(dtype)
+            window = d2[k, xa:xb, ya:yb]
+            np.minimum(window, (gx * gx + dtype(gz[k] ** 2))[:, None] + (gy * gy)[None, :],
+                       out=window)
+    return d2
+
+
+def _gaps(first: IntArray | int, stop: IntArray | int, index: IntArray) -> IntArray:
+    """Cells between ``index`` and the range ``first <= i < stop`` (0 inside it)."""
+    return np.maximum(np.maximum(first - index, index - (stop - 1)), 0)
+
+
+def _edt(occupied: BoolArray, resolution: float) -> NDArray[np.float32]:
+    if not occupied.any():
+        return np.full(occupied.shape, np.inf, dtype=np.float32)
+    distance = ndimage.distance_transform_edt(~occupied, sampling=resolution)
+    return np.asarray(distance, dtype=np.float32)
+
+
+def _cell_of(points: ArrayLike, origin: FloatArray, resolution: float) -> IntArray:
+    p = np.asarray(points, dtype=float).reshape(-1, len(origin))
+    return np.floor((p - origin) / resolution).astype(np.intp)
+
+
+def _center_of(cells: ArrayLike, origin: FloatArray, resolution: float) -> FloatArray:
+    c = np.asarray(cells, dtype=float).reshape(-1, len(origin))
+    return origin + (c + 0.5) * resolution
+
+
+class _Field:
+    """Fast lookups in a field of any memory layout: one ``take`` on its flat memory."""
+
+    def __init__(self, field: NDArray[np.float32]) -> None:
+        order = np.argsort(field.strides)[::-1]  # axes from the slowest-varying in memory
+        dense = field.transpose(order)
+        if not dense.flags.c_contiguous:
+            dense = np.ascontiguousarray(dense)
+        self.flat = dense.reshape(-1)
+        steps = np.cumprod((1, *dense.shape[::-1]))[:-1][::-1]  # elements per step, dense axes
+        self.steps = np.empty(field.ndim, dtype=np.intp)
+        self.steps[order] = steps
+        self.shape = np.array(field.shape)
+
+    def at(self, cells: IntArray) -> FloatArray:
+        """``(N,)`` values at ``cells``; 0 for cells outside the field."""
+        inside = ((cells >= 0) & (cells < self.shape)).all(axis=1)
+        values = self.flat.take(np.where(inside, cells @ self.steps, 0)).astype(float)
+        values[~inside] = 0.0
+        return values
+
+
+def _frozen(array: A) -> A:
+    array.setflags(write=False)
+    return array
