@@ -54,7 +54,7 @@ def run(mission, out: Path | None):  # type: ignore[no-untyped-def]
     sim = Simulation(mission, out_dir=out)
     result = sim.run()
     return (time.perf_counter() - t0, result, sim.cosim.step_time, sim.cosim.client.steps,
-            sim.outputs_time)
+            sim.outputs_time, sim.navigator)
 
 
 def main() -> None:
@@ -74,7 +74,7 @@ def main() -> None:
             runs.append(run(mission, Path(tmp) / str(i)))
         rrd = Path(tmp) / "0" / "recording.rrd"
         size = rrd.stat().st_size
-    wall, result, stepping, steps, writing = sorted(runs, key=lambda r: r[0])[len(runs) // 2]
+    wall, result, stepping, steps, writing, nav = sorted(runs, key=lambda r: r[0])[len(runs) // 2]
     bare = statistics.median(run(mission, None)[0] for _ in range(args.repeat))
     print(f"default mission, physics, recording on ({result.end_time:.1f} s simulated, "
           f"outcome {result.outcome}):")
@@ -87,6 +87,8 @@ def main() -> None:
     print(f"  outputs (recording, event log, summary): {writing * 1e3:.0f} ms, "
           f"{writing / wall:.1%} of the run (goal < 10%); recording {size / 1024:.0f} KiB, "
           f"{size / 1024 / (result.end_time / 60):.0f} KiB per simulated minute")
+    print(f"  planning ({nav.method} mode): {nav.seconds * 1e3:.0f} ms, {nav.seconds / wall:.1%} "
+          f"of the run; {nav.plans} legs planned around furniture")
     print(f"  the same run without outputs: {bare:.2f} s")
     waited = mission.with_changes(assignment={**mission.spec.assignment.model_dump(),
                                               "start_at": 3600.0},
