@@ -61,8 +61,17 @@ class GeometricSensor:
         return Sighting(float(times[i]), _xyz(pts[i]), _xyz(targets[i]), float(d[i]))
 
     def coverage(self, robot: Robot, points: FloatArray, room: Room) -> float:
-        """Share of ``room``'s floor cells seen from any point of the path ``points``."""
+        """Share of ``room``'s free floor cells (not under furniture) seen from any point of
+        the path ``points``."""
         cells = floor_cells(room)
+        still = self.scene.static_bodies([room.id])
+        if still:
+            boxes = np.array([[p.box.lo, p.box.hi] for p in still])
+            under = np.any(np.all((cells[:, None, :2] >= boxes[None, :, 0, :2]) &
+                                  (cells[:, None, :2] <= boxes[None, :, 1, :2]), axis=2), axis=1)
+            cells = cells[~under]
+            if len(cells) == 0:
+                return 0.0
         pts, _ = resample(np.asarray(points, dtype=float), CELL)
         d = np.linalg.norm(pts[:, None, :] - cells[None, :, :], axis=2)
         pi, ci = np.nonzero(d <= robot.detection_radius)

@@ -164,6 +164,38 @@ def bench_navigator(args: argparse.Namespace) -> None:
           f"{failures} of {args.plans} routes failed")
 
 
+def bench_coverage() -> None:
+    """(e) Share of each room's free floor a UAV's search pattern sees, over the 18 rooms of
+    building A, empty (messiness 0) and furnished at messiness 1."""
+    from astralis_des import Simulation, load_mission
+    from astralis_des.actions import coverage as cov
+    from astralis_des.actions.common import footprint_spacing, plane_to_floor
+
+    base = load_mission(ROOT / "missions" / "urban_search.yaml")
+    patterns = {
+        "spiral_inward": lambda box, s: cov.spiral(box, s, True),
+        "spiral_outward": lambda box, s: cov.spiral(box, s, False),
+        "sweep_horizontal": lambda box, s: cov.lawnmower(box, s, 0),
+        "sweep_vertical": lambda box, s: cov.lawnmower(box, s, 1),
+    }
+    for messiness in (0.0, 1.0):
+        sim = Simulation(base.with_changes(rooms={"set": {
+            r: {"messiness": messiness} for r in base.world.rooms}}))
+        uav = sim.robots["uav1"]
+        spacing = footprint_spacing(uav, 0.2)
+        shares = {}
+        for name, make in patterns.items():
+            values = []
+            for rid in sorted(r for r in sim.world.rooms if r.startswith("A.")):
+                room = sim.world.rooms[rid]
+                plan = plane_to_floor(room, make(room.box, spacing)) + [0, 0, uav.height]
+                values.append(sim.sensor.coverage(uav, plan, room))
+            shares[name] = (statistics.mean(values), min(values))
+        text = ", ".join(f"{k} {m:.1%} (min {lo:.1%})" for k, (m, lo) in shares.items())
+        goal = " (goal >= 90%)" if messiness == 0 else " (reported)"
+        print(f"(e) coverage of free floor at messiness {messiness:g}{goal}: {text}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--plans", type=int, default=30)
@@ -177,6 +209,7 @@ def main() -> None:
     bench_ugv(world, vmap, args)
     bench_uav(world, vmap, args)
     bench_navigator(args)
+    bench_coverage()
 
 
 if __name__ == "__main__":
