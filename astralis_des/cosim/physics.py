@@ -28,6 +28,8 @@ from astralis_des.kernel.scene import Mover
 from astralis_des.physics.client import PhysicsClient
 from astralis_des.physics.drivers import DRIVERS, Driver
 from astralis_des.physics.hexacopter import write_urdf
+from astralis_des.physics.local import RATE as LOCAL_RATE
+from astralis_des.physics.local import LocalLayer
 from astralis_des.sensing import GeometricSensor, Sighting
 from astralis_des.world.clutter import Clutter
 from astralis_des.world.geometry import FloatArray
@@ -87,6 +89,9 @@ class PhysicsCoSim:
         self.names = {d.body: rid for rid, d in self.drivers.items()}
         self.names.update({self.client.static: "wall", self.client.ground: "ground"})
         self._scene = sim.scene
+        self.robots = sim.robots
+        self._navigator = sim.navigator
+        self.local = LocalLayer(self, list(sim.robots))
         self.t = 0.0  # physics time: whole control periods
         self._add_scene(sim)
         self.site = sim.world.site
@@ -126,6 +131,10 @@ class PhysicsCoSim:
             body = self.client.add_box(mover.position_at(self.t), mover.size)
             self.movers.append((mover, body))
             self.names[body] = mover.kind
+
+    def clearance(self, points: FloatArray) -> FloatArray:
+        """Distance to the nearest wall or slab (the navigator's map)."""
+        return np.asarray(self._navigator.map.clearance(points))
 
     def _move_movers(self) -> None:
         """Put each mover where it is at the end of the coming tick. Done at the contact
@@ -227,8 +236,11 @@ class PhysicsCoSim:
     def _advance(self, ticks: int) -> list[tuple[str, MotionOutcome]]:
         """Step up to ``ticks`` control periods; stop at the first that ends a motion."""
         check_every = max(1, round(1.0 / (CONTACT_CHECKS_PER_S * self.period)))
+        local_every = max(1, round(1.0 / (LOCAL_RATE * self.period)))
         for _ in range(ticks):
             check = self._ticks % check_every == 0
+            if self._ticks % local_every == 0:
+                self.local.update(self.t)
             finished = [(rid, out) for rid, (robot, track, _) in self.active.items()
                         if (out := self._tick(rid, track, check)) is not None]
             if finished:

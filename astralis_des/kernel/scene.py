@@ -9,6 +9,7 @@ is known at any time, in both fidelities.
 
 from __future__ import annotations
 
+import bisect
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -45,13 +46,23 @@ class Mover:
     def __post_init__(self) -> None:
         seg = np.linalg.norm(np.diff(self.loop, axis=0), axis=1)
         object.__setattr__(self, "cum", np.concatenate([[0.0], np.cumsum(seg)]))
+        # plain lists for one position at a time: asked every tick in physics
+        object.__setattr__(self, "_cum", self.cum.tolist())
+        object.__setattr__(self, "_points", self.loop.tolist())
 
     def positions_at(self, times: FloatArray) -> FloatArray:
         s = (self.offset + self.speed * np.asarray(times, dtype=float)) % max(self.cum[-1], 1e-9)
         return np.column_stack([np.interp(s, self.cum, self.loop[:, k]) for k in range(3)])
 
     def position_at(self, t: float) -> FloatArray:
-        return self.positions_at(np.array([t]))[0]
+        cum, points = self._cum, self._points  # type: ignore[attr-defined]
+        s = (self.offset + self.speed * t) % max(cum[-1], 1e-9)
+        i = min(max(bisect.bisect_right(cum, s) - 1, 0), len(cum) - 2)
+        span = cum[i + 1] - cum[i]
+        w = (s - cum[i]) / span if span > 0 else 0.0
+        a, b = points[i], points[i + 1]
+        return np.array([a[0] + w * (b[0] - a[0]), a[1] + w * (b[1] - a[1]),
+                         a[2] + w * (b[2] - a[2])])
 
 
 @dataclass(frozen=True)

@@ -164,7 +164,7 @@ class PhysicsSpec(Strict):
 
     rate: Annotated[int, Field(ge=30, le=2000)] = Field(240, description="physics steps per s")
     control_rate: Annotated[int, Field(ge=10, le=2000)] = Field(
-        80, description="controller updates per s; must divide rate")
+        60, description="controller updates per s; must divide rate")
     log_rate: PositiveFloat = Field(10.0, description="pose samples per s in the recording")
     stuck_timeout: PositiveFloat = Field(15.0, description="s without progress: the action fails")
     solver_iterations: Annotated[int, Field(ge=1, le=200)] = 20

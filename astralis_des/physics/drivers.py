@@ -24,6 +24,7 @@ from astralis_des.registry import Registry
 from astralis_des.world.geometry import FloatArray
 
 ARRIVED = 0.2  # m from the end of its path, nearly still: a UAV has arrived
+SHIFT_RATE = 0.5  # m/s: how fast a robot moves aside to keep right, or back
 UGV_RATE = 40  # Hz: pure pursuit updates (when the control rate is a multiple of it)
 FACING = 0.08  # rad: close enough to the heading asked for
 LIFT_RISE = 0.3  # m: a leg climbing more than this is ridden on the stairwell's vehicle lift
@@ -36,6 +37,8 @@ class Driver(Protocol):
     def tick(self, t: float) -> str | None: ...
     def position(self) -> FloatArray: ...
     def freeze(self) -> None: ...
+    def heading_vector(self) -> FloatArray: ...
+    def avoid(self, hold: bool, shift: FloatArray) -> None: ...
 
 
 DRIVERS: Registry[str, type] = Registry("driver")
@@ -66,14 +69,33 @@ class UavDriver:
         pos, vel = motion.sample(np.asarray(t + ticks * self.period, dtype=float))
         self.ref_pos, self.ref_vel = pos.tolist(), vel.tolist()
         self.goal = pos[-1]
+        self.k = 0  # the reference's clock, in ticks: it stops while the robot holds
+        self.held = False
+        self.shift = np.zeros(2)
+        self.shift_to = np.zeros(2)
+
+    def avoid(self, hold: bool, shift: FloatArray) -> None:
+        self.held, self.shift_to = hold, np.asarray(shift, dtype=float)
+
+    def heading_vector(self) -> FloatArray:
+        if self.motion is None or self.held:
+            return np.zeros(2)
+        vel = self.ref_vel[min(self.k, len(self.ref_vel) - 1)]
+        return np.array(vel[:2])
 
     def tick(self, t: float) -> str | None:
-        k = min(round((t - self.t0) / self.period), len(self.ref_pos) - 1)
-        if t >= self.end:
+        last = len(self.ref_pos) - 1
+        k = min(self.k, last)
+        if k >= last:
             pos, _, v, _ = self.craft.state()
             if math.dist(pos, self.goal) < ARRIVED and math.hypot(*v) < 0.3:
                 return "arrived"
-        self.craft.control(self.ref_pos[k], self.ref_vel[k])
+        if not self.held:
+            self.k += 1
+        self.shift = _ramp(self.shift, self.shift_to, SHIFT_RATE * self.period)
+        ref = self.ref_pos[k]
+        target = (ref[0] + self.shift[0], ref[1] + self.shift[1], ref[2])
+        self.craft.control(target, (0.0, 0.0, 0.0) if self.held else self.ref_vel[k])
         return None
 
     def position(self) -> FloatArray:
@@ -98,10 +120,23 @@ class UgvDriver:
         self.legs: list[tuple[bool, FloatArray]] = []
         self.speed = robot.speed
         self.lift: tuple[float, FloatArray] | None = None
+        self.period = 1.0 / spec.control_rate
         self.every = max(1, round(spec.control_rate / UGV_RATE))
         self._ticks = 0
         self.turning = False
         self.heading = 0.0
+        self.held = False
+        self.shift = np.zeros(2)
+        self.shift_to = np.zeros(2)
+
+    def avoid(self, hold: bool, shift: FloatArray) -> None:
+        self.held, self.shift_to = hold, np.asarray(shift, dtype=float)
+
+    def heading_vector(self) -> FloatArray:
+        if self.held or self.turning or self.lift is not None or not len(self.husky.path):
+            return np.zeros(2)
+        yaw = self.husky.pose()[3]
+        return np.array([math.cos(yaw), math.sin(yaw)]) * self.speed
 
     def turn_to(self, heading: float) -> None:
         """Turn on the spot until the body faces ``heading``."""
@@ -165,6 +200,11 @@ class UgvDriver:
         self._ticks += 1
         if self._ticks % self.every and not self.lift:  # the wheel motors hold their targets
             return None
+        if self.held:
+            self.husky.drive(0.0, 0.0)
+            return None
+        self.shift = _ramp(self.shift, self.shift_to, SHIFT_RATE * self.period * self.every)
+        self.husky.offset = self.shift
         if self.husky.track():
             if not self.legs:
                 return "arrived"
@@ -185,20 +225,50 @@ class HumanDriver:
 
     def __init__(self, client: PhysicsClient, robot: Robot, spec: PhysicsSpec, urdf: Path) -> None:
         self.offset = np.array([0.0, 0.0, robot.height - (RADIUS + HEIGHT / 2)])
+        self.period = 1.0 / spec.control_rate
         self.walker = Walker(client, robot.pose - self.offset)
         self.body = self.walker.body
         self.motion: Motion | None = None
 
     def start(self, motion: Motion, t: float) -> None:
         self.motion = motion
+        self.elapsed = 0.0  # walking time so far: it stops while the walker waits
+        self.held = False
+        self.shift = np.zeros(2)
+        self.shift_to = np.zeros(2)
+
+    def avoid(self, hold: bool, shift: FloatArray) -> None:
+        self.held, self.shift_to = hold, np.asarray(shift, dtype=float)
+
+    def heading_vector(self) -> FloatArray:
+        if self.motion is None or self.held:
+            return np.zeros(2)
+        return np.asarray(self.motion.velocity(self.motion.t0 + self.elapsed)[:2])
 
     def tick(self, t: float) -> str | None:
         assert self.motion is not None
-        self.walker.place(self.motion.at(t) - self.offset)
-        return "arrived" if t >= self.motion.t0 + self.motion.duration else None
+        if not self.held:
+            self.elapsed += self.period
+        self.shift = _ramp(self.shift, self.shift_to, SHIFT_RATE * self.period)
+        where = self.motion.at(self.motion.t0 + self.elapsed) - self.offset
+        where[:2] += self.shift
+        self.walker.place(where)
+        return "arrived" if self.elapsed >= self.motion.duration else None
 
     def position(self) -> FloatArray:
         return self.walker.position() + self.offset
 
     def freeze(self) -> None:
         """A walker is kinematic: standing still costs nothing."""
+
+
+def _ramp(current: FloatArray, target: FloatArray, step: float) -> FloatArray:
+    """Move ``current`` towards ``target`` by at most ``step`` (plain floats: every tick)."""
+    dx, dy = float(target[0] - current[0]), float(target[1] - current[1])
+    if dx == 0.0 and dy == 0.0:
+        return current
+    norm = math.hypot(dx, dy)
+    if norm <= step:
+        return np.array([float(target[0]), float(target[1])])
+    k = step / norm
+    return np.array([float(current[0]) + dx * k, float(current[1]) + dy * k])

@@ -43,6 +43,7 @@ class Husky:
         self.cum: FloatArray = np.zeros(1)
         self.progress = 0.0
         self.speed = 1.0
+        self.offset = np.zeros(2)  # shift of the pursued point (keeping right)
         self.drive(0.0, 0.0)
 
     def pose(self) -> tuple[float, float, float, float]:
@@ -111,6 +112,7 @@ class Husky:
             return True
         self.progress = self._project(x, y)
         gx, gy = self._point_at(self.progress + LOOKAHEAD)
+        gx, gy = gx + float(self.offset[0]), gy + float(self.offset[1])
         alpha = math.atan2(gy - y, gx - x) - yaw
         alpha = math.atan2(math.sin(alpha), math.cos(alpha))
         if abs(alpha) > math.pi / 3:  # face the path first: turn on the spot
