@@ -24,7 +24,7 @@ from astralis_des.registry import Registry
 from astralis_des.world.geometry import FloatArray
 
 ARRIVED = 0.2  # m from the end of its path, nearly still: a UAV has arrived
-SHIFT_RATE = 0.5  # m/s: how fast a robot moves aside to keep right, or back
+SHIFT_RATE = 1.2  # m/s: how fast a robot moves aside to keep right, or back
 UGV_RATE = 40  # Hz: pure pursuit updates (when the control rate is a multiple of it)
 FACING = 0.08  # rad: close enough to the heading asked for
 LIFT_RISE = 0.3  # m: a leg climbing more than this is ridden on the stairwell's vehicle lift
@@ -197,11 +197,11 @@ class UgvDriver:
             if share >= 1.0:
                 self._next_leg(t)
             return None
-        self._ticks += 1
-        if self._ticks % self.every and not self.lift:  # the wheel motors hold their targets
-            return None
         if self.held:
             self.husky.drive(0.0, 0.0)
+            return None
+        self._ticks += 1
+        if self._ticks % self.every and not self.lift:  # the wheel motors hold their targets
             return None
         self.shift = _ramp(self.shift, self.shift_to, SHIFT_RATE * self.period * self.every)
         self.husky.offset = self.shift

@@ -24,7 +24,9 @@ from astralis_des.world.geometry import FloatArray
 if TYPE_CHECKING:
     from astralis_des.cosim.physics import PhysicsCoSim
 
-PASS_RANGE = 3.0  # m: closer than this, head-on, both keep right
+PASS_RANGE = 5.0  # m: closer than this, head-on, both keep right
+LOOK_AHEAD = 0.8  # s: where the others will be, for the lane test
+BRAKING = 1.0  # s: the stopping range grows by this times the robot's speed
 SHIFT = 0.7  # m to the right at most
 STOP_RANGE = 0.8  # m between bodies' edges ahead: hold
 LANE_MARGIN = 0.15  # m added to the two radii to decide "in my lane"
@@ -88,14 +90,14 @@ class LocalLayer:
             right = np.array([forward[1], -forward[0]])
             near = np.linalg.norm(where - me.xy, axis=1) < PASS_RANGE + 1.0
             hold, shift = self._decide(me, [b for b, c in zip(bodies, near, strict=True) if c],
-                                       forward, right)
+                                       forward, right, speed)
             if shift and not self._room_to_the_side(me, right, shift):
                 shift = 0.0
             self.holds += hold
             driver.avoid(hold, right * shift)
 
     def _decide(self, me: Body, others: list[Body], forward: FloatArray,
-                right: FloatArray) -> tuple[bool, float]:
+                right: FloatArray, speed: float = 1.0) -> tuple[bool, float]:
         hold, shift = False, 0.0
         for other in others:
             if other.name == me.name or other.z[1] < me.z[0] or other.z[0] > me.z[1]:
@@ -112,7 +114,10 @@ class LocalLayer:
                 # standing in our lane: pass it on the side with more room
                 side = across - lane if across >= 0 else across + lane
                 shift = side if abs(side) > abs(shift) else shift
-            if abs(across - shift) < lane and gap < STOP_RANGE and other.rank > me.rank:
+            soon = rel + other.velocity * LOOK_AHEAD
+            in_lane = abs(across) < lane or (float(soon @ forward) > 0 and
+                                             abs(float(soon @ right)) < lane)
+            if in_lane and gap < STOP_RANGE + BRAKING * speed and other.rank > me.rank:
                 hold = True
         return hold, shift
 
