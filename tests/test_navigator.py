@@ -103,3 +103,21 @@ def test_a_failed_route_fails_the_task_and_the_mission_goes_on() -> None:
     assert failed[0]["status"] == "failed"
     assert "inside a building or obstacle" in failed[0]["message"]
     assert result.outcome == "found"
+
+
+def test_the_map_is_in_the_recording_when_used(tmp_path: Path) -> None:
+    """A physics run that planned on the voxel map records its occupied voxels, once."""
+    import shutil
+    import subprocess
+
+    sim = Simulation(load_mission(ROOT / "missions" / "fig7.yaml").with_changes(
+        fidelity="physics"), out_dir=tmp_path)
+    sim.run()
+    assert sim.navigator.map_built
+    points = sim.navigator.occupied_points()
+    assert 100_000 < len(points) and points[:, 2].min() > 0.0
+    rrd = tmp_path / "recording.rrd"
+    assert rrd.stat().st_size > 500_000  # 150k points (compressed), logged once
+    if shutil.which("rerun"):
+        assert subprocess.run(["rerun", "rrd", "verify", str(rrd)],
+                              capture_output=True).returncode == 0

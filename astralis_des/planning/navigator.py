@@ -90,6 +90,19 @@ class Navigator:
 
     # -- what is in the way ----------------------------------------------------------------
     @property
+    def map_built(self) -> bool:
+        return self._map is not None
+
+    def occupied_points(self) -> FloatArray:
+        """Centres of the map's occupied voxels above the ground (once per world)."""
+        voxels = self.map
+        cache: dict[str, FloatArray] = voxels.__dict__.setdefault("_occupied_points", {})
+        if "above" not in cache:
+            centres = voxels.center_of(np.argwhere(voxels.occupied))
+            cache["above"] = centres[centres[:, 2] > 0.05]
+        return cache["above"]
+
+    @property
     def map(self) -> VoxelMap:
         if self._map is None:
             from astralis_des.planning.occupancy import world_map

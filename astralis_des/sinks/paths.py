@@ -9,6 +9,7 @@ WORLD_ROOMS = "world/rooms"
 WORLD_TARGET = "world/target"
 WORLD_FURNITURE = "world/furniture"
 WORLD_ROADS = "world/roads"
+WORLD_OCCUPANCY = "world/occupancy"  # the planner's voxel map
 MISSION_EVENTS = "mission/events"
 MISSION_ROUNDS = "mission/assignment"
 

@@ -100,6 +100,14 @@ class RerunRecorder:
     def close(self, result: RunResult) -> None:
         rr, rec = self.rr, self.rec
         log_furniture(rr, rec, self.sim.scene.furnished())
+        navigator = self.sim.navigator
+        if navigator.map_built:  # the planner's occupancy map, when this run used it
+            points = navigator.occupied_points()
+            heights = np.clip(points[:, 2] / 12.0, 0.0, 1.0)
+            colors = np.column_stack([60 + 150 * heights, 90 + 60 * heights,
+                                      200 - 120 * heights]).astype(np.uint8)
+            rec.log(paths.WORLD_OCCUPANCY, rr.Points3D(points, radii=0.1, colors=colors),
+                    static=True)
         self._log_movers(result.end_time)
         for entity, column in self._texts.items():
             rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE,
