@@ -137,11 +137,13 @@ class PhysicsCoSim:
         return np.asarray(self._navigator.map.clearance(points))
 
     def _move_movers(self) -> None:
-        """Put each mover where it is at the end of the coming tick. Done at the contact
-        checks' rate (30 Hz): a walker then jumps about 3 cm at a time."""
+        """Put the movers near a moving robot where they are at the end of the coming tick.
+        Done at the contact checks' rate (30 Hz): a walker then jumps about 3 cm at a time;
+        one far from every moving robot touches nothing and jumps when it comes near."""
         reset, then = self.client.call, self.t + self.period
         self.movers_time = then
-        for mover, body in self.movers:
+        for index in self.local.near:
+            mover, body = self.movers[index]
             reset("resetBasePositionAndOrientation", body, mover.position_at(then).tolist(),
                   [0.0, 0.0, 0.0, 1.0])
 

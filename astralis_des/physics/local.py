@@ -33,7 +33,8 @@ LANE_MARGIN = 0.15  # m added to the two radii to decide "in my lane"
 HEIGHTS = {"uav": (-0.1, 0.1), "ugv": (-0.5, 0.0), "human": (-1.6, 0.15)}  # around the pose
 RADII = {"uav": 0.3, "ugv": 0.4, "human": 0.25}
 STILL_RANK = 10_000  # movers, and robots not moving: everyone yields to them
-RATE = 10.0  # Hz: how often the layer decides
+NEAR = 6.0  # m: movers farther than this from every moving robot need not move in physics
+RATE = 5.0  # Hz: how often the layer decides (a UAV flies 0.3 m in between)
 
 
 @dataclass
@@ -51,6 +52,7 @@ class LocalLayer:
         self.cosim = cosim
         self.rank = {rid: len(order) - i for i, rid in enumerate(order)}
         self.holds = 0  # how many times a robot was held (for tests and benchmarks)
+        self.near: list[int] = []  # movers within NEAR of a moving robot: the ones to move
 
     def bodies(self, t: float) -> list[Body]:
         found = []
@@ -75,9 +77,14 @@ class LocalLayer:
     def update(self, t: float) -> None:
         """Decide, for each moving robot, whether to hold and how far to shift aside."""
         if not self.cosim.active:
+            self.near = []
             return
         bodies = self.bodies(t)
         where = np.array([b.xy for b in bodies])
+        robots = len(self.cosim.drivers)
+        moving = np.array([b.xy for b in bodies[:robots] if b.name in self.cosim.active])
+        gaps = np.linalg.norm(where[robots:, None, :] - moving[None, :, :], axis=2)
+        self.near = [int(i) for i in np.flatnonzero((gaps < NEAR).any(axis=1))]
         for rid in self.cosim.active:
             driver = self.cosim.drivers[rid]
             me = next(b for b in bodies if b.name == rid)
