@@ -181,8 +181,7 @@ class Simulation:
         """Can this robot's kind get to the room from where it is (stairs, ramps, doors)?"""
         here = robot.position(self.env.now).copy()
         here[2] = self.world.floor_below(here)
-        return self.world.router.route(here, self.world.rooms[room_id].door_point("corridor"),
-                                       robot.kind) is not None
+        return self.world.router.reachable(here, room_id, robot.kind)
 
     # -- detection -------------------------------------------------------------------------
     def report_detection(self, robot: Robot, sighting: Sighting) -> None:

@@ -11,7 +11,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import shortest_path
 
 from astralis_des.errors import InputError
-from astralis_des.world.geometry import FloatArray, segments_hit_boxes
+from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
 from astralis_des.world.model import World
 
 KINDS = ("uav", "ugv", "human")
@@ -32,6 +32,9 @@ class Router:
         self._edges: list[tuple[int, int, dict[str, float]]] = []
         self.corridor_nodes: dict[str, list[int]] = {}
         self.outdoor_nodes: list[int] = []
+        self._reach: dict[tuple[str, str, str], bool] = {}
+        self._space_ids = list(world.spaces)
+        self._space_boxes = boxes_array([s.box for s in world.spaces.values()])
         self._footprints = self._outdoor_blockers()
         self._snap_boxes = [(r.id, r.box) for r in world.rooms.values()] + [
             (s.id, s.box) for s in world.spaces.values()]
@@ -144,9 +147,10 @@ class Router:
         room = self.world.room_at(p)
         if room is not None:
             return room.id
-        for space in self.world.spaces.values():
-            if space.box.contains(p, margin=0.05):
-                return space.id
+        inside = np.all((p >= self._space_boxes[:, 0] - 0.05) &
+                        (p <= self._space_boxes[:, 1] + 0.05), axis=1)
+        if inside.any():
+            return self._space_ids[int(np.argmax(inside))]
         near = self._nearest_space(p)
         if near is not None:  # in a wall's thickness, by a doorway: a body's centre can be
             return near
@@ -182,6 +186,16 @@ class Router:
         pts = self.positions[nodes]
         clear = self._outdoor_clear(np.repeat(p[None, :], len(pts), 0), pts)
         return [int(n) for n in nodes[clear]]
+
+    def reachable(self, start: FloatArray | tuple[float, ...], room_id: str, kind: str) -> bool:
+        """Can a ``kind`` get from ``start`` to the room? It depends only on the place ``start``
+        is in (any point of a room, corridor or the outdoors connects alike): cached."""
+        place = self.place_of(start)
+        key = (kind, place, room_id)
+        if key not in self._reach:
+            door = self.world.rooms[room_id].door_point("corridor")
+            self._reach[key] = self.route(start, door, kind) is not None
+        return self._reach[key]
 
     def route(self, start: FloatArray | tuple[float, ...], goal: FloatArray | tuple[float, ...],
               kind: str) -> FloatArray | None:
