@@ -150,35 +150,28 @@ class PhysicsCoSim:
     # -- the co-simulation contract ------------------------------------------------------
     def execute(self, robot: Robot, motion: Motion) -> simpy.Event:
         self.halt(robot)
-        driver = self.drivers[robot.id]
         motion.t0 = self.env.now
-        driver.start(motion, self.env.now)
-        track = Track(driver, self.env.now)
-        track.sample(self.env.now)
-        track.checkpoint = (self.env.now, track.points[-1])
-        robot.begin(track, self.env.now)  # type: ignore[arg-type]
-        done = self.env.event()
-        self.active[robot.id] = (robot, track, done)
-        if not self._wake.triggered:
-            self._wake.succeed()
-        return done
+        self.drivers[robot.id].start(motion, self.env.now)
+        return self._activate(robot)
 
     def face(self, robot: Robot, heading: float) -> simpy.Event:
         """Turn on the spot to ``heading``: the UGV turns its body; others look at once."""
+        self.halt(robot)
+        robot.heading = heading
         driver = self.drivers[robot.id]
         if not hasattr(driver, "turn_to"):
-            self.halt(robot)
-            robot.heading = heading
             return self.env.timeout(0.0, value=MotionOutcome(True, "arrived"))
-        self.halt(robot)
         driver.turn_to(heading)
-        track = Track(driver, self.env.now)
+        return self._activate(robot)
+
+    def _activate(self, robot: Robot) -> simpy.Event:
+        """Hand a started driver to the stepper; the event fires when its motion ends."""
+        track = Track(self.drivers[robot.id], self.env.now)
         track.sample(self.env.now)
         track.checkpoint = (self.env.now, track.points[-1])
         robot.begin(track, self.env.now)  # type: ignore[arg-type]
         done = self.env.event()
         self.active[robot.id] = (robot, track, done)
-        robot.heading = heading
         if not self._wake.triggered:
             self._wake.succeed()
         return done

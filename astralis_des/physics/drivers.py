@@ -44,8 +44,24 @@ class Driver(Protocol):
 DRIVERS: Registry[str, type] = Registry("driver")
 
 
+class Avoiding:
+    """What the local layer sets on a driver: hold still, and how far to stand aside."""
+
+    held: bool = False
+    shift: FloatArray
+    shift_to: FloatArray
+
+    def _clear_avoidance(self) -> None:
+        self.held = False
+        self.shift = np.zeros(2)
+        self.shift_to = np.zeros(2)
+
+    def avoid(self, hold: bool, shift: FloatArray) -> None:
+        self.held, self.shift_to = hold, np.asarray(shift, dtype=float)
+
+
 @DRIVERS.register("uav")
-class UavDriver:
+class UavDriver(Avoiding):
     """Flies a constant-speed reference along the path (the kinematic motion itself)."""
 
     def __init__(self, client: PhysicsClient, robot: Robot, spec: PhysicsSpec, urdf: Path) -> None:
@@ -70,12 +86,7 @@ class UavDriver:
         self.ref_pos, self.ref_vel = pos.tolist(), vel.tolist()
         self.goal = pos[-1]
         self.k = 0  # the reference's clock, in ticks: it stops while the robot holds
-        self.held = False
-        self.shift = np.zeros(2)
-        self.shift_to = np.zeros(2)
-
-    def avoid(self, hold: bool, shift: FloatArray) -> None:
-        self.held, self.shift_to = hold, np.asarray(shift, dtype=float)
+        self._clear_avoidance()
 
     def heading_vector(self) -> FloatArray:
         if self.motion is None or self.held:
@@ -108,7 +119,7 @@ class UavDriver:
 
 
 @DRIVERS.register("ugv")
-class UgvDriver:
+class UgvDriver(Avoiding):
     """Pure pursuit on each floor; between floors the stairwell's lift carries it."""
 
     def __init__(self, client: PhysicsClient, robot: Robot, spec: PhysicsSpec, urdf: Path) -> None:
@@ -125,12 +136,7 @@ class UgvDriver:
         self._ticks = 0
         self.turning = False
         self.heading = 0.0
-        self.held = False
-        self.shift = np.zeros(2)
-        self.shift_to = np.zeros(2)
-
-    def avoid(self, hold: bool, shift: FloatArray) -> None:
-        self.held, self.shift_to = hold, np.asarray(shift, dtype=float)
+        self._clear_avoidance()
 
     def heading_vector(self) -> FloatArray:
         if self.held or self.turning or self.lift is not None or not len(self.husky.path):
@@ -220,7 +226,7 @@ class UgvDriver:
 
 
 @DRIVERS.register("human")
-class HumanDriver:
+class HumanDriver(Avoiding):
     """Walks the path at its speed, kinematically: a capsule placed at each tick."""
 
     def __init__(self, client: PhysicsClient, robot: Robot, spec: PhysicsSpec, urdf: Path) -> None:
@@ -233,12 +239,7 @@ class HumanDriver:
     def start(self, motion: Motion, t: float) -> None:
         self.motion = motion
         self.elapsed = 0.0  # walking time so far: it stops while the walker waits
-        self.held = False
-        self.shift = np.zeros(2)
-        self.shift_to = np.zeros(2)
-
-    def avoid(self, hold: bool, shift: FloatArray) -> None:
-        self.held, self.shift_to = hold, np.asarray(shift, dtype=float)
+        self._clear_avoidance()
 
     def heading_vector(self) -> FloatArray:
         if self.motion is None or self.held:

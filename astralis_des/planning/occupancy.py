@@ -37,23 +37,17 @@ _TIE = 1e-5  # m: a clearance equal to the radius is not free, however float32 r
 
 
 @dataclass(frozen=True, eq=False)
-class GridMap:
-    """A 2-D occupancy grid and its distance field, indexed ``[i, j]`` like the voxel map."""
+class _FieldGrid:
+    """An occupancy grid in any dimension with its distance field: the queries both maps
+    answer alike, indexed ``[i, j(, k)]``."""
 
-    origin: FloatArray  # (2,) corner of cell (0, 0)
+    origin: FloatArray  # corner of cell (0, ...)
     resolution: float
-    occupied: BoolArray  # (nx, ny)
-    distance: NDArray[np.float32]  # (nx, ny) metres to the nearest occupied cell's centre
-
-    @classmethod
-    def from_occupancy(cls, occupied: BoolArray, origin: ArrayLike,
-                       resolution: float) -> GridMap:
-        occupied = np.array(occupied, dtype=bool)  # a copy: it is made read-only
-        return cls(_frozen(np.array(origin, dtype=float)), resolution, _frozen(occupied),
-                   _frozen(_edt(occupied, resolution)))
+    occupied: BoolArray
+    distance: NDArray[np.float32]  # metres to the nearest occupied cell's centre
 
     def cell_of(self, points: ArrayLike) -> IntArray:
-        """``(N, 2)`` indices of the cells holding ``points`` (possibly outside the grid)."""
+        """``(N, D)`` indices of the cells holding ``points`` (possibly outside the grid)."""
         return _cell_of(points, self.origin, self.resolution)
 
     def center_of(self, cells: ArrayLike) -> FloatArray:
@@ -73,32 +67,21 @@ class GridMap:
 
 
 @dataclass(frozen=True, eq=False)
-class VoxelMap:
-    """A 3-D occupancy grid and its distance field; arrays are read-only and may be shared."""
+class GridMap(_FieldGrid):
+    """A 2-D occupancy grid (``(nx, ny)``) and its distance field."""
 
-    origin: FloatArray  # (3,) corner of voxel (0, 0, 0)
-    resolution: float
-    occupied: BoolArray  # (nx, ny, nz)
-    distance: NDArray[np.float32]  # (nx, ny, nz) metres to the nearest occupied voxel's centre
+    @classmethod
+    def from_occupancy(cls, occupied: BoolArray, origin: ArrayLike,
+                       resolution: float) -> GridMap:
+        occupied = np.array(occupied, dtype=bool)  # a copy: it is made read-only
+        return cls(_frozen(np.array(origin, dtype=float)), resolution, _frozen(occupied),
+                   _frozen(_edt(occupied, resolution)))
 
-    def cell_of(self, points: ArrayLike) -> IntArray:
-        """``(N, 3)`` indices of the voxels holding ``points`` (possibly outside the map)."""
-        return _cell_of(points, self.origin, self.resolution)
 
-    def center_of(self, cells: ArrayLike) -> FloatArray:
-        return _center_of(cells, self.origin, self.resolution)
-
-    def clearance(self, points: ArrayLike) -> FloatArray:
-        """``(N,)`` distance field at each point's voxel; 0 outside the map."""
-        return self._field.at(self.cell_of(points))
-
-    @cached_property
-    def _field(self) -> _Field:
-        return _Field(self.distance)
-
-    def free(self, points: ArrayLike, radius: float) -> BoolArray:
-        """``(N,)``: is each point's clearance more than ``radius``? (Equal is not.)"""
-        return self.clearance(points) > radius + _TIE
+@dataclass(frozen=True, eq=False)
+class VoxelMap(_FieldGrid):
+    """A 3-D occupancy grid (``(nx, ny, nz)``) and its distance field; arrays are read-only
+    and may be shared."""
 
     def segment_free(self, p0: ArrayLike, p1: ArrayLike, radius: float) -> bool:
         """Is every point of the segment, sampled every half voxel, free for ``radius``?"""
