@@ -47,3 +47,44 @@ def test_a_good_physics_section_validates(tmp_path: Path,
     path = mission_with(tmp_path, "  rate: 240\n  control_rate: 80\n  log_rate: 10\n")
     assert main(["validate", str(path)]) == 0
     assert capsys.readouterr().out.startswith("ok: ")
+
+
+@pytest.mark.parametrize(("member", "key", "says"), [
+    ("{id: uav9, kind: uav, start: [90, 60, 0], sensors: {camera: {width: 0}}}",
+     "team[4].sensors.camera.width", "greater than 0"),
+    ("{id: uav9, kind: uav, start: [90, 60, 0], sensors: {camera: {height: -4}}}",
+     "team[4].sensors.camera.height", "greater than 0"),
+    ("{id: uav9, kind: uav, start: [90, 60, 0], sensors: {camera: {fov_deg: 180}}}",
+     "team[4].sensors.camera.fov_deg", "less than 180"),
+    ("{id: uav9, kind: uav, start: [90, 60, 0], sensors: {camera: {fov_deg: 0}}}",
+     "team[4].sensors.camera.fov_deg", "greater than 0"),
+    ("{id: uav9, kind: uav, start: [90, 60, 0], sensors: {lidar: {beams: 0}}}",
+     "team[4].sensors.lidar.beams", "greater than or equal to 1"),
+    ("{id: op9, kind: human, start: [96, 66, 0], sensors: {lidar: {}}}",
+     "team[4]", "sensors.lidar: a human cannot carry a lidar; it carries: camera"),
+])
+def test_bad_sensors_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                 member: str, key: str, says: str) -> None:
+    """Impossible sensors: one line naming the key, exit 2."""
+    text = (ROOT / "missions" / "fig7.yaml").read_text(encoding="utf-8").replace(
+        "world: ../worlds/urban_default.yaml", f"world: {ROOT / 'worlds' / 'urban_default.yaml'}")
+    text = text.replace("  - {id: op1, kind: human, start: [100, 40, 0]}",
+                        f"  - {{id: op1, kind: human, start: [100, 40, 0]}}\n  - {member}")
+    path = tmp_path / "mission.yaml"
+    path.write_text(text, encoding="utf-8")
+    assert main(["validate", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert f": {key}" in err and says in err, err
+
+
+def test_sensors_a_kind_can_carry_are_accepted(tmp_path: Path) -> None:
+    """A UGV with camera, lidar and IMU, and a human with a camera, validate."""
+    text = (ROOT / "missions" / "fig7.yaml").read_text(encoding="utf-8").replace(
+        "world: ../worlds/urban_default.yaml", f"world: {ROOT / 'worlds' / 'urban_default.yaml'}")
+    text = text.replace("  - {id: ugv1, kind: ugv, start: [73, 78.25, 0]}",
+                        "  - {id: ugv1, kind: ugv, start: [73, 78.25, 0], sensors: "
+                        "{camera: {width: 160, height: 120}, lidar: {beams: 180}, imu: {}}}")
+    path = tmp_path / "mission.yaml"
+    path.write_text(text, encoding="utf-8")
+    assert main(["validate", str(path)]) == 0

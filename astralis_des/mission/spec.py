@@ -20,6 +20,48 @@ class Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
+class CameraSpec(Strict):
+    """A pinhole camera: RGB, depth and segmentation (physics), or its frustum (kinematic)."""
+
+    width: int = Field(320, gt=0, le=4096, description="pixels")
+    height: int = Field(240, gt=0, le=4096, description="pixels")
+    fov_deg: float = Field(60.0, gt=0, lt=180, description="vertical field of view")
+    range: PositiveFloat = Field(8.0, description="m: farther than this is not detected")
+    pitch_deg: float = Field(0.0, ge=-90, le=90, description="0 forward, 90 straight down")
+    min_pixels: int = Field(40, ge=1, description="target pixels a detection needs")
+
+
+class LidarSpec(Strict):
+    """A 2-D lidar in the robot's horizontal plane."""
+
+    beams: int = Field(360, ge=1, le=4096)
+    range: PositiveFloat = 30.0
+    rate: PositiveFloat = Field(10.0, description="scans per s")
+    noise_std: NonNegativeFloat = Field(0.01, description="m, range noise")
+
+
+class ImuSpec(Strict):
+    """An IMU: specific force and angular rate, with noise and constant biases."""
+
+    rate: PositiveFloat = Field(100.0, description="readings per s")
+    accel_noise: NonNegativeFloat = 0.02
+    gyro_noise: NonNegativeFloat = 0.002
+    accel_bias: Vec3 = (0.0, 0.0, 0.0)
+    gyro_bias: Vec3 = (0.0, 0.0, 0.0)
+
+
+class SensorsSpec(Strict):
+    camera: CameraSpec | None = Field(default_factory=CameraSpec)
+    lidar: LidarSpec | None = None
+    imu: ImuSpec | None = None
+
+
+# What each kind can carry: the human operator has eyes (a camera model) and nothing else.
+CARRIES: dict[str, tuple[str, ...]] = {
+    "uav": ("camera", "lidar", "imu"), "ugv": ("camera", "lidar", "imu"), "human": ("camera",),
+}
+
+
 class MemberSpec(Strict):
     """One agent of the team."""
 
@@ -30,6 +72,15 @@ class MemberSpec(Strict):
     detection_radius: PositiveFloat | None = Field(None, description="m; default by kind")
     height: PositiveFloat | None = Field(
         None, description="m above the floor of its sensor (UAV: flight altitude)")
+    sensors: SensorsSpec = Field(default_factory=SensorsSpec)
+
+    @model_validator(mode="after")
+    def _can_carry(self) -> MemberSpec:
+        for name in ("camera", "lidar", "imu"):
+            if getattr(self.sensors, name) is not None and name not in CARRIES[self.kind]:
+                raise ValueError(f"sensors.{name}: a {self.kind} cannot carry a {name}; it "
+                                 f"carries: {', '.join(CARRIES[self.kind])}")
+        return self
 
 
 class RoomProps(Strict):
