@@ -87,7 +87,8 @@ class PhysicsCoSim:
             rid: DRIVERS.get(robot.kind)(self.client, robot, spec, urdf)
             for rid, robot in sim.robots.items()}
         self.names = {d.body: rid for rid, d in self.drivers.items()}
-        self.names.update({self.client.static: "wall", self.client.ground: "ground"})
+        self.names.update(dict.fromkeys(self.client.static, "wall"))
+        self.names[self.client.ground] = "ground"
         self._scene = sim.scene
         self.robots = sim.robots
         self._navigator = sim.navigator
@@ -121,8 +122,8 @@ class PhysicsCoSim:
     def _furnish(self, room_id: str, clutter: Clutter, movers: bool = True) -> None:
         still = [p for p in clutter.placed if dict(p.attributes).get("activity") != "patrolling"]
         if still:
-            body = self.client.add_boxes([p.box.lo for p in still], [p.box.hi for p in still])
-            self.names[body] = "furniture"
+            bodies = self.client.add_boxes([p.box.lo for p in still], [p.box.hi for p in still])
+            self.names.update(dict.fromkeys(bodies, "furniture"))
         if movers:
             self._add_movers(self._scene.avatar_movers([room_id]))
 

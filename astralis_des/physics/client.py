@@ -16,12 +16,13 @@ from astralis_des.world.model import World
 __all__ = ["GRAVITY", "PhysicsClient", "quiet_c_output"]
 
 GRAVITY = 9.81
+COMPOUND = 16  # shapes PyBullet keeps in one compound (MAX_COMPOUND_COLLISION_SHAPES)
 
 
 class PhysicsClient:
     """A DIRECT-mode PyBullet client with the world's walls, slabs and obstacles in it.
 
-    The static geometry is one compound body of boxes (simple shapes, one broadphase entry);
+    The static geometry is compound bodies of boxes (simple shapes, few broadphase entries);
     the ground is a plane. ``step`` counts the wall time spent inside ``stepSimulation``.
     """
 
@@ -45,16 +46,24 @@ class PhysicsClient:
         """``pybullet.<name>(*args, **kwargs)`` on this client."""
         return getattr(pb, name)(*args, physicsClientId=self.id, **kwargs)
 
-    def _add_static(self, world: World) -> int:
+    def _add_static(self, world: World) -> list[int]:
         return self.add_boxes([s.box.lo for s in world.solids], [s.box.hi for s in world.solids])
 
-    def add_boxes(self, los: Any, his: Any) -> int:
-        """One static compound body of axis-aligned boxes given by their corners."""
+    def add_boxes(self, los: Any, his: Any) -> list[int]:
+        """Static compound bodies of axis-aligned boxes given by their corners.
+
+        PyBullet keeps at most 16 shapes of one ``createCollisionShapeArray`` call and drops
+        the rest without a word, so the boxes go in compounds of ``COMPOUND`` at most.
+        """
         lo, hi = np.asarray(los, dtype=float), np.asarray(his, dtype=float)
-        shape = self.call("createCollisionShapeArray", [pb.GEOM_BOX] * len(lo),
-                          halfExtents=((hi - lo) / 2).tolist(),
-                          collisionFramePositions=((hi + lo) / 2).tolist())
-        return int(self.call("createMultiBody", 0, shape))
+        bodies = []
+        for start in range(0, len(lo), COMPOUND):
+            a, b = lo[start:start + COMPOUND], hi[start:start + COMPOUND]
+            shape = self.call("createCollisionShapeArray", [pb.GEOM_BOX] * len(a),
+                              halfExtents=((b - a) / 2).tolist(),
+                              collisionFramePositions=((b + a) / 2).tolist())
+            bodies.append(int(self.call("createMultiBody", 0, shape)))
+        return bodies
 
     def add_box(self, centre: Any, size: Any) -> int:
         """A box body without mass: static, or moved kinematically by resetting its pose."""
