@@ -47,7 +47,11 @@ class PhysicsClient:
         return getattr(pb, name)(*args, physicsClientId=self.id, **kwargs)
 
     def _add_static(self, world: World) -> list[int]:
-        return self.add_boxes([s.box.lo for s in world.solids], [s.box.hi for s in world.solids])
+        """Walls, slabs and obstacles; not what lies wholly below the ground plane (the ground
+        floors' slabs): the plane is that floor already, and a wheel on a plane costs half what
+        it costs on a box."""
+        above = [s for s in world.solids if s.box.hi[2] > 1e-6]
+        return self.add_boxes([s.box.lo for s in above], [s.box.hi for s in above])
 
     def add_boxes(self, los: Any, his: Any) -> list[int]:
         """Static compound bodies of axis-aligned boxes given by their corners.
