@@ -18,6 +18,7 @@ import numpy as np
 
 from astralis_des.actions import coverage as cov
 from astralis_des.kinds import TARGET_HEIGHT
+from astralis_des.streams import stream
 from astralis_des.world.catalogue import Catalogue
 from astralis_des.world.clutter import Clutter, Placed, free_spot, place_room
 from astralis_des.world.geometry import Box, FloatArray, boxes_array, segments_hit_boxes
@@ -27,7 +28,6 @@ STANDING = (0.5, 0.5)  # m, footprint of a sitting, standing or walking avatar
 LAYING = (1.8, 0.6)
 PATROL_INSET = 1.0  # m from the walls of a patrolled room
 AVATAR_HEIGHTS = {"tall": 1.85, "medium": 1.72, "short": 1.58}
-STREAMS = {"target": 2, "movers": 5}
 
 
 @dataclass(frozen=True)
@@ -113,7 +113,7 @@ class Scene:
             if not self.enabled:
                 self._rooms[room_id] = Clutter((), ())
             else:
-                rng = np.random.default_rng([self.seed, 4, self._order[room_id]])
+                rng = stream(self.seed, "clutter", self._order[room_id])
                 placed = place_room(self.world, room_id, self.messiness.get(room_id, 0.0), rng,
                                     self.catalogue)
                 self._rooms[room_id] = self._clear_target(room_id, placed)
@@ -172,7 +172,7 @@ class Scene:
         room = self.world.rooms[room_id]
         floor = room.box.lo[2]
         if position is None:
-            rng = np.random.default_rng([self.seed, STREAMS["target"], 1])
+            rng = stream(self.seed, "target", 1)
             spot = free_spot(self.world, room_id, self.clutter(room_id), (w, d), rng,
                              self.catalogue)
             if spot is None:  # no free spot left: the room's centre, furniture moved aside
@@ -201,7 +201,7 @@ class Scene:
 
     # -- moving obstacles ------------------------------------------------------------------
     def _corridor_movers(self, count: int, speed: float) -> list[Mover]:
-        rng = np.random.default_rng([self.seed, STREAMS["movers"]])
+        rng = stream(self.seed, "movers")
         corridors = sorted(s for s, sp in self.world.spaces.items() if sp.kind == "corridor")
         movers = []
         for i in range(count):

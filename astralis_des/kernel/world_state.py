@@ -4,10 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from astralis_des.kernel.scene import Scene, Target
 from astralis_des.mission.loader import Mission
+from astralis_des.streams import stream
 
 SOUNDS = ("minimal", "moderate", "loud")
 AVATAR_VALUES: dict[str, tuple[object, ...]] = {
@@ -17,14 +16,6 @@ AVATAR_VALUES: dict[str, tuple[object, ...]] = {
     "height": ("tall", "medium", "short"),
     "tied_to_chair": (True, False),
 }
-# One independent stream per purpose, so drawing more of one never shifts another.
-STREAMS = {"rooms": 1, "target": 2, "avatar": 3}
-
-
-def rng(seed: int, purpose: str) -> np.random.Generator:
-    return np.random.default_rng([seed, STREAMS[purpose]])
-
-
 @dataclass
 class RoomState:
     risk: float
@@ -34,7 +25,7 @@ class RoomState:
 
 def draw_rooms(mission: Mission) -> dict[str, RoomState]:
     """Uniform risk and messiness in [0, 1] and a sound per room, then the file's overrides."""
-    gen = rng(mission.spec.seed, "rooms")
+    gen = stream(mission.spec.seed, "rooms")
     states = {}
     for room_id in sorted(mission.world.rooms):
         risk, mess = gen.uniform(0.0, 1.0, size=2)
@@ -50,11 +41,11 @@ def draw_target(mission: Mission, scene: Scene) -> Target:
     """The target avatar: its room (given or drawn from the searched rooms), attributes (given
     or drawn from Table II), and place (given, or a free spot among the furniture)."""
     spec = mission.spec.target
-    gen = rng(mission.spec.seed, "target")
+    gen = stream(mission.spec.seed, "target")
     candidates = mission.searched_rooms() or sorted(mission.world.rooms)
     room_id = spec.room or candidates[int(gen.integers(len(candidates)))]
     given = spec.avatar.model_dump(exclude_none=True)
-    avatar_gen = rng(mission.spec.seed, "avatar")
+    avatar_gen = stream(mission.spec.seed, "avatar")
     avatar = {}
     for key, values in AVATAR_VALUES.items():
         drawn = values[int(avatar_gen.integers(len(values)))]

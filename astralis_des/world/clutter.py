@@ -15,6 +15,7 @@ import numpy as np
 from scipy import ndimage
 
 from astralis_des.errors import suggest
+from astralis_des.streams import stream
 from astralis_des.world.catalogue import Catalogue, avatar_size, default_catalogue
 from astralis_des.world.freespace import CROSS, BoolArray, FreeSpace, room_free_space
 from astralis_des.world.geometry import Box
@@ -131,7 +132,7 @@ def place_world(world: World, messiness: Mapping[str, float], seed: int,
     skipped: list[tuple[str, str, str]] = []
     for index, room_id in enumerate(order):
         if room_id in messiness:
-            rng = np.random.default_rng([seed, 4, index])
+            rng = stream(seed, "clutter", index)
             clutter = place_room(world, room_id, messiness[room_id], rng, catalogue)
             placed += clutter.placed
             skipped += clutter.skipped
