@@ -64,9 +64,8 @@ class GeometricSensor:
         """Share of ``room``'s free floor cells (not under furniture) seen from any point of
         the path ``points``."""
         cells = floor_cells(room)
-        still = self.scene.static_bodies([room.id])
-        if still:
-            boxes = np.array([[p.box.lo, p.box.hi] for p in still])
+        boxes = self.scene.still_boxes([room.id])
+        if len(boxes):
             under = np.any(np.all((cells[:, None, :2] >= boxes[None, :, 0, :2]) &
                                   (cells[:, None, :2] <= boxes[None, :, 1, :2]), axis=2), axis=1)
             cells = cells[~under]
@@ -80,7 +79,7 @@ class GeometricSensor:
         seen = np.zeros(len(cells), dtype=bool)
         lo, hi = np.asarray(room.box.lo), np.asarray(room.box.hi)
         inside = np.all((pts >= lo) & (pts <= hi), axis=1)
-        if not self.scene.static_bodies([room.id]):
+        if not len(boxes):
             # An empty room is a convex box: from inside it every cell is in sight.
             seen[ci[inside[pi]]] = True
         todo = ~seen[ci]

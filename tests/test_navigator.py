@@ -21,7 +21,7 @@ def mission(**planning: object) -> Mission:
 
 
 def furnished(sim: Simulation, room: str, *items: Placed) -> None:
-    sim.scene._rooms[room] = Clutter(items, ())
+    sim.scene.set_clutter(room, Clutter(items, ()))
 
 
 def clear_everywhere(sim: Simulation, kind: str, points: np.ndarray) -> bool:

@@ -94,7 +94,7 @@ def test_a_cabinet_between_robot_and_target_hides_it(world: World) -> None:
 
     def seen(with_cabinet: bool) -> bool:
         scene = Scene(world, dict.fromkeys(world.rooms, 0.0), 0, default_catalogue())
-        scene._rooms[room.id] = Clutter((cabinet,) if with_cabinet else (), ())
+        scene.set_clutter(room.id, Clutter((cabinet,) if with_cabinet else (), ()))
         sensor = GeometricSensor(scene, scene.place_target(room.id, {"activity": "idle"},
                                                            target))
         return sensor.sighting_from(robot, eye, 0.0) is not None

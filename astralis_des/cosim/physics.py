@@ -120,9 +120,9 @@ class PhysicsCoSim:
             self.names[body] = "target"
 
     def _furnish(self, room_id: str, clutter: Clutter, movers: bool = True) -> None:
-        still = [p for p in clutter.placed if dict(p.attributes).get("activity") != "patrolling"]
-        if still:
-            bodies = self.client.add_boxes([p.box.lo for p in still], [p.box.hi for p in still])
+        still = self._scene.still_boxes([room_id])
+        if len(still):
+            bodies = self.client.add_boxes(still[:, 0], still[:, 1])
             self.names.update(dict.fromkeys(bodies, "furniture"))
         if movers:
             self._add_movers(self._scene.avatar_movers([room_id]))

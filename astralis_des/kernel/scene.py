@@ -102,6 +102,7 @@ class Scene:
         self.listeners: list[Callable[[str, Clutter], None]] = []
         self._order = {rid: i for i, rid in enumerate(sorted(world.rooms))}
         self._rooms: dict[str, Clutter] = {}
+        self._still: dict[str, FloatArray] = {}  # room -> boxes of what stays put in it
         self._reserved: dict[str, Box] = {}  # room -> the target's footprint, kept free
         self.target: Target | None = None
         self.movers: list[Mover] = self._corridor_movers(movers, mover_speed)
@@ -111,18 +112,23 @@ class Scene:
         """The room's furniture and avatars, placed on first use."""
         if room_id not in self._rooms:
             if not self.enabled:
-                self._rooms[room_id] = Clutter((), ())
+                self.set_clutter(room_id, Clutter((), ()))
             else:
                 rng = stream(self.seed, "clutter", self._order[room_id])
                 placed = place_room(self.world, room_id, self.messiness.get(room_id, 0.0), rng,
                                     self.catalogue)
-                self._rooms[room_id] = self._clear_target(room_id, placed)
+                self.set_clutter(room_id, self._clear_target(room_id, placed))
                 if self.on_skipped is not None:
                     for skipped in self._rooms[room_id].skipped:
                         self.on_skipped(*skipped)
             for listener in self.listeners:
                 listener(room_id, self._rooms[room_id])
         return self._rooms[room_id]
+
+    def set_clutter(self, room_id: str, clutter: Clutter) -> None:
+        """Furnish a room with ``clutter`` (placement, the target's room, tests)."""
+        self._rooms[room_id] = clutter
+        self._still.pop(room_id, None)
 
     def _clear_target(self, room_id: str, placed: Clutter) -> Clutter:
         keep = self._reserved.get(room_id)
@@ -149,6 +155,16 @@ class Scene:
         """Furniture and avatars that stay put (not the patrolling ones) in these rooms."""
         return [p for rid in room_ids for p in self.clutter(rid).placed
                 if dict(p.attributes).get("activity") != "patrolling"]
+
+    def still_boxes(self, room_ids: Iterable[str]) -> FloatArray:
+        """``(K, 2, 3)`` corners of what stays put in these rooms: each room's once, kept
+        (sight, coverage and planning ask for them again and again)."""
+        arrays = []
+        for rid in room_ids:
+            if rid not in self._still:
+                self._still[rid] = boxes_array([p.box for p in self.static_bodies([rid])])
+            arrays.append(self._still[rid])
+        return np.concatenate(arrays) if arrays else np.zeros((0, 2, 3))
 
     def avatar_movers(self, rooms: Iterable[str] | None = None) -> list[Mover]:
         """Patrolling bystanders of the furnished rooms (or of ``rooms``), as movers, and a
@@ -181,7 +197,7 @@ class Scene:
         self._reserved[room_id] = Box((position[0] - w / 2, position[1] - d / 2, floor),
                                       (position[0] + w / 2, position[1] + d / 2, floor + 1.8))
         if room_id in self._rooms:
-            self._rooms[room_id] = self._clear_target(room_id, self._rooms[room_id])
+            self.set_clutter(room_id, self._clear_target(room_id, self._rooms[room_id]))
         mover = None
         if avatar.get("activity") == "patrolling":
             height = AVATAR_HEIGHTS.get(str(avatar.get("height")), 1.72)
@@ -218,7 +234,7 @@ class Scene:
     def blockers(self, rooms: Iterable[str]) -> FloatArray:
         """Boxes that block sight: walls, slabs, obstacles, and the furniture and avatars that
         stay put in ``rooms`` (the target excluded)."""
-        extra = boxes_array([p.box for p in self.static_bodies(rooms)])
+        extra = self.still_boxes(rooms)
         return np.concatenate([self.world.solid_array, extra]) if len(extra) else \
             self.world.solid_array
 

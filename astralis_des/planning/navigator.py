@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from astralis_des.errors import InputError
-from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
+from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
 if TYPE_CHECKING:
     from astralis_des.kernel.robot import Robot
@@ -115,7 +115,7 @@ class Navigator:
         rooms = [rid for rid, room in self.world.rooms.items()
                  if np.all(np.asarray(room.box.lo) <= hi) and
                  np.all(np.asarray(room.box.hi) >= lo)]
-        return boxes_array([p.box for p in self.scene.static_bodies(rooms)])
+        return self.scene.still_boxes(rooms)
 
     def _valid(self, robot: Robot, points: FloatArray, radius: float) -> np.ndarray:
         pts = np.atleast_2d(points)
