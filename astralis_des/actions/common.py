@@ -66,8 +66,7 @@ def at_height(robot: Robot, floor_points: FloatArray) -> FloatArray:
 def route(ctx: Context, robot: Robot,
           goal_floor: FloatArray | tuple[float, ...]) -> Route:
     """Route from where the robot is to a floor-level goal, at the robot's sensor height."""
-    here = robot.position(ctx.env.now).copy()
-    here[2] = ctx.world.floor_below(here)  # where it stands, or the floor it flies over
+    here = ctx.world.on_floor(robot.position(ctx.env.now))
     return ctx.navigator.route(robot, here, np.asarray(goal_floor, dtype=float))
 
 

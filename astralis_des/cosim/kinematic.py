@@ -60,5 +60,3 @@ class KinematicCoSim:
 
     def close(self) -> None:
         """Nothing to release; the physics fidelity frees its client here."""
-
-    step_time = 0.0

@@ -179,8 +179,7 @@ class Simulation:
 
     def _reaches(self, robot: Robot, room_id: str) -> bool:
         """Can this robot's kind get to the room from where it is (stairs, ramps, doors)?"""
-        here = robot.position(self.env.now).copy()
-        here[2] = self.world.floor_below(here)
+        here = self.world.on_floor(robot.position(self.env.now))
         return self.world.router.reachable(here, room_id, robot.kind)
 
     # -- detection -------------------------------------------------------------------------

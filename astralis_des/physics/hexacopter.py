@@ -67,7 +67,6 @@ class Hexacopter:
                            self.spin * spec.moment_constant])
         self.mix = np.linalg.pinv(alloc)
         self.max_thrust = spec.thrust_constant * spec.max_rotor_speed**2
-        self.inertia = np.array(spec.inertia)
         hover = math.sqrt(spec.mass * GRAVITY / ROTORS / spec.thrust_constant)
         self.tilt = math.tan(math.radians(spec.max_tilt_deg))
         lag = spec.motor_time_constant

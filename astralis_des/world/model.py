@@ -131,6 +131,13 @@ class World:
                 return storey * b.floor_height
         return 0.0
 
+    def on_floor(self, point: tuple[float, ...] | FloatArray) -> FloatArray:
+        """``point`` brought down to the floor under it: where a robot stands, or the floor a
+        UAV flies over (routes are asked between such points)."""
+        here = np.array(point, dtype=float)
+        here[2] = self.floor_below(here)
+        return here
+
     def contains(self, point: tuple[float, ...] | FloatArray) -> bool:
         x, y = float(point[0]), float(point[1])
         return 0.0 <= x <= self.site[0] and 0.0 <= y <= self.site[1]
