@@ -1,4 +1,4 @@
-"""What each agent kind is by default: speed, sensing reach and height of its sensor."""
+"""What each agent kind is by default: speed, camera, height of its sensor, sensor set."""
 
 from __future__ import annotations
 
@@ -6,21 +6,39 @@ from dataclasses import dataclass
 
 
 @dataclass(frozen=True)
+class CameraDefaults:
+    """A kind's camera when the mission does not say: its reach and where it looks."""
+
+    range: float  # m: farther than this the target is not detected
+    fov_deg: float  # vertical field of view
+    pitch_deg: float  # 0 forward, 90 straight down
+    gimbal: bool  # levelled and turned to the direction of travel (else fixed to the body)
+    look_around: bool  # while waiting in place it pans a full turn (a hovering UAV, a person)
+
+
+@dataclass(frozen=True)
 class KindDefaults:
     speed: float  # m/s, cruise
-    detection_radius: float  # m, reach of its camera for the geometric detection model
+    camera: CameraDefaults
     height: float  # m above the floor of its sensor (a UAV's flight altitude indoors)
     distance: str  # Eq. 1's distance for this kind: "l2" or "manhattan"
+    sensors: tuple[str, ...]  # what it carries when the mission names no sensors
     accel: float | None = None  # m/s^2 speeding up and slowing down; None for a walker
     turn_rate: float | None = None  # rad/s turning on the spot (a non-holonomic robot)
 
 
 KIND_DEFAULTS: dict[str, KindDefaults] = {
-    "uav": KindDefaults(speed=1.5, detection_radius=2.0, height=1.5, distance="l2",
-                        accel=2.0),
-    "ugv": KindDefaults(speed=1.0, detection_radius=6.0, height=0.5, distance="manhattan",
+    # A gimballed camera 75 degrees down: at 1.5 m over the floor it sees a strip about
+    # 3 m wide below the craft, mostly ahead of it.
+    "uav": KindDefaults(speed=1.5, camera=CameraDefaults(2.0, 90.0, 75.0, True, True),
+                        height=1.5, distance="l2", sensors=("camera", "imu"), accel=2.0),
+    # A forward camera on the body, and a lidar the local planner slows down for.
+    "ugv": KindDefaults(speed=1.0, camera=CameraDefaults(6.0, 60.0, 0.0, False, False),
+                        height=0.5, distance="manhattan", sensors=("camera", "lidar", "imu"),
                         accel=1.0, turn_rate=1.0),
-    "human": KindDefaults(speed=1.2, detection_radius=3.0, height=1.6, distance="manhattan"),
+    # A person's eyes: a wide view a little down, ahead of where they walk.
+    "human": KindDefaults(speed=1.2, camera=CameraDefaults(3.0, 90.0, 15.0, True, True),
+                          height=1.6, distance="manhattan", sensors=("camera",)),
 }
 KINDS = tuple(KIND_DEFAULTS)
 TARGET_HEIGHT = 0.5  # m above the floor: the centre of a sitting or laying avatar

@@ -1,8 +1,11 @@
-"""The kinematic fidelity's sensing model: a detection radius plus a line of sight.
+"""The kinematic fidelity's sensing model: a camera frustum plus a line of sight.
 
-Walls, slabs, obstacles, furniture and avatars block sight. Physics fidelity replaces the
-model with rendered cameras; both answer the same two questions: when, along a motion, is the
-target first seen, and what share of a room's floor did the robot see.
+A robot's camera (:class:`View`) sees a point when it lies within the camera's range and
+inside its pinhole frustum, and no wall, slab, obstacle, furniture or avatar is in between.
+A gimballed camera (UAV, person) turns to the direction of travel; a body camera (UGV) turns
+with the body. Physics fidelity replaces the model with rendered frames; both answer the same
+questions: when, along a motion, is the target first seen, where was it estimated to be, and
+what share of a room's floor did the robot see.
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ import numpy as np
 
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kinds import TARGET_HEIGHT
+from astralis_des.view import look_headings, travel_headings
 from astralis_des.world.geometry import FloatArray, resample
 from astralis_des.world.model import Room
 
@@ -30,39 +34,60 @@ class Sighting:
     robot_position: tuple[float, float, float]
     target_position: tuple[float, float, float]
     distance: float
+    estimate: tuple[float, float, float]  # where the sensor put the target
+    error: float  # m between the estimate and the target
+    pixels: int | None = None  # target pixels in the frame (physics)
 
 
 class GeometricSensor:
     """Detection and coverage from the scene's bodies and the target's whereabouts."""
 
-    def __init__(self, scene: Scene, target: Target) -> None:
+    def __init__(self, scene: Scene, target: Target,
+                 rng: np.random.Generator | None = None) -> None:
         self.scene = scene
         self.target = target
+        self.rng = rng if rng is not None else np.random.default_rng(0)
 
     def first_sighting(self, robot: Robot, motion: Motion) -> Sighting | None:
+        if robot.view is None:
+            return None
         pts, s = resample(motion.points, SAMPLE_STEP)
+        headings = travel_headings(pts, robot.heading)
         times = motion.time_of(s)
-        return self._first(robot, pts, times, self.target.positions_at(motion.t0 + times))
+        return self._first(robot, pts, headings, times,
+                           self.target.positions_at(motion.t0 + times))
 
     def sighting_from(self, robot: Robot, position: FloatArray, now: float) -> Sighting | None:
-        here = np.asarray(position, dtype=float)[None, :]
-        return self._first(robot, here, np.zeros(1), self.target.positions_at(np.array([now])))
+        """Looking from ``position`` now (around, for a camera that pans while waiting)."""
+        if robot.view is None:
+            return None
+        headings = look_headings(robot.view, robot.heading)
+        here = np.repeat(np.asarray(position, dtype=float)[None, :], len(headings), axis=0)
+        targets = np.repeat(self.target.positions_at(np.array([now])), len(headings), axis=0)
+        return self._first(robot, here, headings, np.zeros(len(headings)), targets)
 
-    def _first(self, robot: Robot, pts: FloatArray, times: FloatArray,
+    def _first(self, robot: Robot, pts: FloatArray, headings: FloatArray, times: FloatArray,
                targets: FloatArray) -> Sighting | None:
-        d = np.linalg.norm(pts - targets, axis=1)
-        near = np.nonzero(d <= robot.detection_radius)[0]
+        assert robot.view is not None
+        near = np.flatnonzero(robot.view.sees(pts, headings, targets))
         if len(near) == 0:
             return None
         clear = self.scene.line_of_sight(pts[near], targets[near])
         if not clear.any():
             return None
         i = int(near[np.argmax(clear)])
-        return Sighting(float(times[i]), _xyz(pts[i]), _xyz(targets[i]), float(d[i]))
+        distance = float(np.linalg.norm(pts[i] - targets[i]))
+        noise = self.rng.normal(0.0, robot.view.position_noise * distance, 3)
+        estimate = targets[i] + noise
+        return Sighting(float(times[i]), _xyz(pts[i]), _xyz(targets[i]), distance,
+                        _xyz(estimate), float(np.linalg.norm(noise)))
 
-    def coverage(self, robot: Robot, points: FloatArray, room: Room) -> float:
-        """Share of ``room``'s free floor cells (not under furniture) seen from any point of
-        the path ``points``."""
+    def coverage(self, robot: Robot, points: FloatArray, room: Room,
+                 headings: FloatArray | None = None) -> float:
+        """Share of ``room``'s free floor cells (not under furniture) seen from the path
+        ``points`` (facing its direction of travel, or ``headings`` given per point)."""
+        if robot.view is None:
+            return 0.0
         cells = floor_cells(room)
         boxes = self.scene.still_boxes([room.id])
         if len(boxes):
@@ -71,22 +96,38 @@ class GeometricSensor:
             cells = cells[~under]
             if len(cells) == 0:
                 return 0.0
-        pts, _ = resample(np.asarray(points, dtype=float), CELL)
-        d = np.linalg.norm(pts[:, None, :] - cells[None, :, :], axis=2)
-        pi, ci = np.nonzero(d <= robot.detection_radius)
+        pts, heads = _sample_path(robot, np.asarray(points, dtype=float), headings)
+        pi = np.repeat(np.arange(len(pts)), len(cells))
+        ci = np.tile(np.arange(len(cells)), len(pts))
+        inside = robot.view.sees(pts[pi], heads[pi], cells[ci])
+        pi, ci = pi[inside], ci[inside]
         if len(pi) == 0:
             return 0.0
         seen = np.zeros(len(cells), dtype=bool)
         lo, hi = np.asarray(room.box.lo), np.asarray(room.box.hi)
-        inside = np.all((pts >= lo) & (pts <= hi), axis=1)
+        in_room = np.all((pts >= lo) & (pts <= hi), axis=1)
         if not len(boxes):
             # An empty room is a convex box: from inside it every cell is in sight.
-            seen[ci[inside[pi]]] = True
+            seen[ci[in_room[pi]]] = True
         todo = ~seen[ci]
         if todo.any():
             clear = self.scene.line_of_sight(pts[pi[todo]], cells[ci[todo]])
             seen[ci[todo][clear]] = True
         return float(seen.mean())
+
+
+def _sample_path(robot: Robot, points: FloatArray,
+                 headings: FloatArray | None) -> tuple[FloatArray, FloatArray]:
+    """Points every ``CELL`` along a path and the camera's heading at each; a single point
+    looks around (or ahead) as a waiting camera does."""
+    assert robot.view is not None
+    if headings is not None:
+        return points, np.asarray(headings, dtype=float)
+    if len(points) == 1:
+        heads = look_headings(robot.view, robot.heading)
+        return np.repeat(points, len(heads), axis=0), heads
+    pts, _ = resample(points, CELL)
+    return pts, travel_headings(pts, robot.heading)
 
 
 def floor_cells(room: Room) -> FloatArray:

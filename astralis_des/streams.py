@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-STREAMS = {"rooms": 1, "target": 2, "avatar": 3, "clutter": 4, "movers": 5}
+STREAMS = {"rooms": 1, "target": 2, "avatar": 3, "clutter": 4, "movers": 5, "sensing": 6,
+           "study": 7}  # study: a scenario's own draws (room values, starts, segment)
 
 
 def stream(seed: int, purpose: str, *keys: int) -> np.random.Generator:

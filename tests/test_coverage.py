@@ -10,6 +10,7 @@ from astralis_des.actions.common import footprint_spacing
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kernel.scene import Scene
 from astralis_des.sensing import GeometricSensor
+from astralis_des.view import View
 from astralis_des.world.catalogue import default_catalogue
 from astralis_des.world.geometry import Box
 from astralis_des.world.model import World
@@ -24,8 +25,9 @@ def sensor(world: World, target: tuple[float, float, float] | None = None,
     return GeometricSensor(scene, scene.place_target(room, {"activity": "idle"}, target))
 
 
-def robot(kind: str = "uav", radius: float = 2.0, height: float = 1.5) -> Robot:
-    return Robot("r", kind, 1.0, radius, height, np.zeros(3))
+def robot(kind: str = "uav", height: float = 1.5, heading: float = 0.0) -> Robot:
+    """A robot with its kind's camera (UAV: 2 m, 60 degrees down; UGV: 6 m, ahead)."""
+    return Robot("r", kind, 1.0, View.of_kind(kind), height, np.zeros(3), heading=heading)
 
 
 def test_spiral_rings_are_spacing_apart_and_inside_the_room() -> None:
@@ -53,8 +55,32 @@ def test_lawnmower_lanes_follow_their_axis(axis: int) -> None:
 
 
 def test_spacing_follows_the_footprint() -> None:
-    """At 1.5 m with a 2 m reach, a target at 0.5 m is seen within sqrt(3) m: spacing 2.77 m."""
-    assert footprint_spacing(robot(), 0.2) == pytest.approx(2 * np.sqrt(3) * 0.8)
+    """A UAV camera 1 m above the target's plane, 75 degrees down, 90 x 106 degrees, 2 m
+    reach sees a strip 3.1 m wide (the frustum's side meets the reach at x = 0.768 m,
+    y = 1.553 m); passes with 20% overlap are 2.48 m apart."""
+    assert footprint_spacing(robot(), 0.2) == pytest.approx(2 * 1.553 * 0.8, abs=0.03)
+
+
+def test_the_uav_camera_sees_ahead_and_below_not_behind() -> None:
+    """Facing east at 1.5 m: a point 1 m ahead on the target plane is seen, 1 m behind or
+    beyond the 2 m reach is not (the view reaches 0.58 m behind, 30 degrees past the
+    vertical); facing west, the one ahead is behind."""
+    view = View.of_kind("uav")
+    eye = np.array([[0.0, 0.0, 1.5]] * 4)
+    points = np.array([[1.0, 0.0, 0.5], [-1.0, 0.0, 0.5], [2.5, 0.0, 0.5], [0.0, 0.0, 0.5]])
+    assert view.sees(eye, np.zeros(4), points).tolist() == [True, False, False, True]
+    assert view.sees(eye, np.full(4, np.pi), points).tolist() == [False, True, False, True]
+
+
+def test_the_ugv_camera_sees_a_75_degree_wedge_ahead() -> None:
+    """A 60 degree vertical field of view at 4:3 is 75.2 degrees across: 37 degrees off the
+    axis is in, 39 is out; 5.9 m is in, 6.1 m is out."""
+    view = View.of_kind("ugv")
+    eye = np.zeros((4, 3))
+    angles = np.radians([37.0, 39.0, 0.0, 0.0])
+    reach = np.array([3.0, 3.0, 5.9, 6.1])
+    points = np.column_stack([reach * np.cos(angles), reach * np.sin(angles), np.zeros(4)])
+    assert view.sees(eye, np.zeros(4), points).tolist() == [True, False, True, False]
 
 
 @pytest.mark.parametrize("pattern", ["spiral_in", "spiral_out", "sweep_x", "sweep_y"])
@@ -78,22 +104,50 @@ def test_a_peek_from_the_door_sees_part_of_the_room_only(world: World) -> None:
     """From the corridor side of the door the walls hide the room's near corners."""
     room = world.rooms["A.1.1.1"]
     eye = np.array([room.door_point("corridor", 0.15)]) + [0, 0, 0.5]
-    share = sensor(world).coverage(robot("ugv", 6.0, 0.5), eye, room)
+    into = np.arctan2(room.center[1] - eye[0, 1], room.center[0] - eye[0, 0])
+    share = sensor(world).coverage(robot("ugv", 0.5, into), eye, room)
     assert 0.4 < share < 0.95
+    away = sensor(world).coverage(robot("ugv", 0.5, into + np.pi), eye, room)
+    assert away == 0.0
 
 
 def test_the_target_is_seen_through_the_door_not_through_the_wall(world: World) -> None:
-    """A target in a room is detected from a path past its door, not from behind its wall."""
+    """A UGV facing a target in a room sees it from the door, not from behind its wall; a
+    UAV flying past the door inside the corridor does not look in (it looks ahead)."""
     room = world.rooms["A.1.1.2"]
     target = (room.center[0], room.center[1], room.box.lo[2] + 0.5)
     seer = sensor(world, target, room.id)
-    r = robot("ugv", 6.0, 0.5)
-    corridor_y = room.door_point("corridor", 1.0)[1]
-    past_door = Motion(np.array([[62.5, corridor_y, 0.5], [79.0, corridor_y, 0.5]]), 1.0)
-    seen = seer.first_sighting(r, past_door)
-    assert seen is not None
-    assert abs(seen.robot_position[0] - room.door.center[0]) < 1.5
+    door = np.array(room.door_point("corridor", 0.5)) + [0, 0, 0.5]
+    into = float(np.arctan2(target[1] - door[1], target[0] - door[0]))
+    seen = seer.sighting_from(robot("ugv", 0.5, into), door, 0.0)
+    assert seen is not None and seen.distance == pytest.approx(np.linalg.norm(door - target))
     neighbour = world.rooms["A.1.1.1"]
-    inside_neighbour = Motion(np.array([neighbour.center, neighbour.door_point("room")]) +
-                              [0, 0, 0.5], 1.0)
-    assert seer.first_sighting(r, inside_neighbour) is None
+    behind = np.array([neighbour.box.hi[0] - 0.5, target[1], 0.5])
+    assert seer.sighting_from(robot("ugv", 0.5, 0.0), behind, 0.0) is None
+    assert np.linalg.norm(behind - target) < 6.0  # in reach: the wall hides it
+    corridor_y = room.door_point("corridor", 1.0)[1]
+    past_door = Motion(np.array([[62.5, corridor_y, 1.5], [79.0, corridor_y, 1.5]]), 1.0)
+    assert seer.first_sighting(robot("uav"), past_door) is None
+
+
+def test_a_detection_estimates_the_position_with_seeded_noise(world: World) -> None:
+    """The estimate is off by about the camera's position_noise times the distance, and the
+    same generator seed gives the same estimate."""
+    room = world.rooms["A.1.1.2"]
+    target = (room.center[0], room.center[1], room.box.lo[2] + 0.5)
+    door = np.array(room.door_point("corridor", 0.5)) + [0, 0, 0.5]
+    into = float(np.arctan2(target[1] - door[1], target[0] - door[0]))
+    r = Robot("r", "ugv", 1.0, View.of_kind("ugv", position_noise=0.05), 0.5, door,
+              heading=into)
+
+    def estimate(seed: int) -> tuple[float, ...]:
+        scene = Scene(world, dict.fromkeys(world.rooms, 0.0), 0, default_catalogue())
+        seer = GeometricSensor(scene, scene.place_target(room.id, {"activity": "idle"}, target),
+                               np.random.default_rng(seed))
+        hit = seer.sighting_from(r, door, 0.0)
+        assert hit is not None
+        assert hit.error == pytest.approx(np.linalg.norm(np.subtract(hit.estimate, target)))
+        assert hit.error < 4 * 0.05 * hit.distance * np.sqrt(3)
+        return hit.estimate
+
+    assert estimate(1) == estimate(1) != estimate(2)

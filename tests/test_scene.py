@@ -16,6 +16,7 @@ from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.scene import Scene
 from astralis_des.kernel.world_state import AVATAR_VALUES
 from astralis_des.sensing import GeometricSensor
+from astralis_des.view import View
 from astralis_des.world.catalogue import default_catalogue
 from astralis_des.world.clutter import Clutter, Placed
 from astralis_des.world.model import World
@@ -90,7 +91,7 @@ def test_a_cabinet_between_robot_and_target_hides_it(world: World) -> None:
     target = (room.center[0], 85.0, room.box.lo[2] + 0.5)
     eye = np.array([room.center[0], 81.0, room.box.lo[2] + 0.5])
     cabinet = Placed("cabinet", room.id, (room.center[0], 83.0, 1.0), (1.2, 0.5, 2.0), 0.0)
-    robot = Robot("r", "ugv", 1.0, 6.0, 0.5, eye)
+    robot = Robot("r", "ugv", 1.0, View.of_kind("ugv"), 0.5, eye, heading=np.pi / 2)
 
     def seen(with_cabinet: bool) -> bool:
         scene = Scene(world, dict.fromkeys(world.rooms, 0.0), 0, default_catalogue())

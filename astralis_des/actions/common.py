@@ -27,6 +27,7 @@ class CoSim(Protocol):
     def dwell(self, robot: Robot, seconds: float) -> simpy.Event: ...
     def face(self, robot: Robot, heading: float) -> simpy.Event: ...
     def halt(self, robot: Robot) -> None: ...
+    def look(self, robot: Robot, sensor: GeometricSensor) -> Sighting | None: ...
 
 
 class MotionFailed(Exception):
@@ -91,7 +92,7 @@ def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> Ste
 def dwell(ctx: Context, robot: Robot, seconds: float) -> StepGen:
     """Stay and look around from where the robot is."""
     ctx.cosim.halt(robot)
-    hit = ctx.sensor.sighting_from(robot, robot.position(ctx.env.now), ctx.env.now)
+    hit = ctx.cosim.look(robot, ctx.sensor)
     if hit is not None:
         ctx.report_detection(robot, hit)
     yield ctx.cosim.dwell(robot, seconds)
@@ -128,10 +129,12 @@ def search_path(ctx: Context, robot: Robot, room: Room, plan: FloatArray, label:
 
 
 def footprint_spacing(robot: Robot, overlap: float) -> float:
-    """Distance between passes: the width the sensor sees on the floor, less the overlap."""
-    drop = max(robot.height - TARGET_HEIGHT, 0.0)
-    reach = np.sqrt(max(robot.detection_radius**2 - drop**2, 0.01))
-    return float(max(2.0 * reach * (1.0 - overlap), 0.5))
+    """Distance between passes: the width the camera sees at the target's height, less the
+    overlap (at least 0.5 m; 1 m for a robot without a camera)."""
+    if robot.view is None:
+        return 1.0
+    swath = robot.view.swath(max(robot.height - TARGET_HEIGHT, 0.0))
+    return float(max(swath * (1.0 - overlap), 0.5))
 
 
 def plane_to_floor(room: Room, plane: FloatArray) -> FloatArray:

@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Generator
+from typing import Any
 
 import numpy as np
+import simpy
 
 from astralis_des.actions import ACTIONS
 from astralis_des.actions.common import (
@@ -19,6 +22,7 @@ from astralis_des.actions.common import (
 )
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task, TaskStatus
+from astralis_des.world.model import Room
 
 SNEAK_OFFSET = 0.5  # m in front of the wall's face: where the UGV's body clears the jambs
 
@@ -29,42 +33,51 @@ def sneak_peek(ctx: Context, robot: Robot, task: Task) -> ActionGen:
     room = room_of(ctx, task)
     if room is None:
         return failed("sneak_peek needs a room")
-    way = route(ctx, robot, room.door_point("corridor", offset=SNEAK_OFFSET))
-    if way.points is None:
-        return failed(way.reason)
-    distance = yield from traverse(ctx, robot, way.points, sense=False)
-    here = robot.position(ctx.env.now)
-    into = math.atan2(room.center[1] - here[1], room.center[0] - here[0])
-    yield ctx.cosim.face(robot, into)  # turn the camera into the room
-    coverage = ctx.sensor.coverage(robot, here[None, :], room)
-    yield from dwell(ctx, robot, float(task.param("dwell", 5.0)))
+    outcome = yield from _peek(ctx, robot, room, float(task.param("dwell", 5.0)))
+    if isinstance(outcome, str):
+        return failed(outcome)
+    distance, coverage = outcome
     return result(TaskStatus.SUCCEEDED, f"sneak peek saw {coverage:.0%} of {room.id}",
                   distance=distance, coverage=coverage)
 
 
 @ACTIONS.register(("ugv", "observe_corridor"))
 def observe_corridor(ctx: Context, robot: Robot, task: Task) -> ActionGen:
-    """Drive the corridor past the doors of the room's segment, scanning into the rooms."""
+    """Drive along the corridor of the room's segment and look into each of its rooms from
+    the door (``dwell`` seconds each, default 1), nearest door first: the camera looks ahead,
+    so the robot turns to each door. The coverage is that of the task's room."""
     room = room_of(ctx, task)
     if room is None:
         return failed("observe_corridor needs a room")
-    corridor = ctx.world.spaces[room.corridor].box
-    doors = [ctx.world.rooms[r].door.center[0] for r in ctx.world.segments[room.segment].rooms]
-    margin = float(task.param("margin", 1.5))
-    x0 = max(min(doors) - margin, corridor.lo[0] + 0.3)
-    x1 = min(max(doors) + margin, corridor.hi[0] - 0.3)
-    y = (corridor.lo[1] + corridor.hi[1]) / 2
-    z = corridor.lo[2]
-    ends = [np.array([x0, y, z]), np.array([x1, y, z])]
     here = robot.position(ctx.env.now)
-    if abs(here[0] - x1) < abs(here[0] - x0):
-        ends.reverse()
-    way = route(ctx, robot, tuple(ends[0]))
-    if way.points is None:
-        return failed(way.reason)
-    distance = yield from traverse(ctx, robot, way.points, sense=False)
-    drive = np.array(ends) + np.array([0.0, 0.0, robot.height])
-    coverage = ctx.sensor.coverage(robot, drive, room)
-    distance += yield from traverse(ctx, robot, drive, sense=True)
+    rooms = sorted((ctx.world.rooms[r] for r in ctx.world.segments[room.segment].rooms),
+                   key=lambda r: r.door.center[0])
+    first, last = rooms[0].door.center[0], rooms[-1].door.center[0]
+    if abs(here[0] - last) < abs(here[0] - first):
+        rooms.reverse()
+    distance, coverage = 0.0, 0.0
+    for other in rooms:
+        outcome = yield from _peek(ctx, robot, other, float(task.param("dwell", 1.0)))
+        if isinstance(outcome, str):
+            return failed(outcome)
+        distance += outcome[0]
+        if other.id == room.id:
+            coverage = outcome[1]
     return result(TaskStatus.SUCCEEDED, f"observed the corridor, saw {coverage:.0%} of {room.id}",
                   distance=distance, coverage=coverage)
+
+
+def _peek(ctx: Context, robot: Robot, room: Room,
+          seconds: float) -> Generator[simpy.Event, Any, tuple[float, float] | str]:
+    """Drive to ``room``'s door, looking ahead; turn into the room and look for ``seconds``.
+    Returns the distance driven and the share of the room seen, or why it failed."""
+    way = route(ctx, robot, room.door_point("corridor", offset=SNEAK_OFFSET))
+    if way.points is None:
+        return way.reason
+    distance = yield from traverse(ctx, robot, way.points, sense=True)
+    here = robot.position(ctx.env.now)
+    into = math.atan2(room.center[1] - here[1], room.center[0] - here[0])
+    yield ctx.cosim.face(robot, into)  # turn the camera into the room
+    coverage = ctx.sensor.coverage(robot, here[None, :], room, headings=np.array([into]))
+    yield from dwell(ctx, robot, seconds)
+    return distance, coverage

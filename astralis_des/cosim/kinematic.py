@@ -10,7 +10,7 @@ import simpy
 
 from astralis_des.cosim import COSIMS
 from astralis_des.kernel.robot import Motion, Robot
-from astralis_des.sensing import GeometricSensor
+from astralis_des.sensing import GeometricSensor, Sighting
 
 if TYPE_CHECKING:
     from astralis_des.kernel.simulation import Simulation
@@ -42,6 +42,10 @@ class KinematicCoSim:
         """An event that succeeds with the first sighting along the motion (never if none)."""
         hit = sensor.first_sighting(robot, motion)
         return self.env.timeout(hit.t, value=hit) if hit is not None else self.env.event()
+
+    def look(self, robot: Robot, sensor: GeometricSensor) -> Sighting | None:
+        """What the robot's camera sees from where it stands now (around, if it pans)."""
+        return sensor.sighting_from(robot, robot.position(self.env.now), self.env.now)
 
     def face(self, robot: Robot, heading: float) -> simpy.Event:
         """Turn on the spot to ``heading`` (at once for a robot that needs not turn)."""

@@ -30,6 +30,7 @@ from astralis_des.physics.drivers import DRIVERS, Driver
 from astralis_des.physics.hexacopter import write_urdf
 from astralis_des.physics.local import RATE as LOCAL_RATE
 from astralis_des.physics.local import LocalLayer
+from astralis_des.physics.perception import Perception
 from astralis_des.sensing import GeometricSensor, Sighting
 from astralis_des.world.clutter import Clutter
 from astralis_des.world.geometry import FloatArray
@@ -95,6 +96,7 @@ class PhysicsCoSim:
         self.local = LocalLayer(self, list(sim.robots))
         self.t = 0.0  # physics time: whole control periods
         self._add_scene(sim)
+        self.perception = Perception(self, sim)
         self.site = sim.world.site
         self.active: dict[str, tuple[Robot, Track, simpy.Event]] = {}
         self.touching: set[tuple[str, str]] = set()
@@ -113,11 +115,24 @@ class PhysicsCoSim:
         for room_id in sorted(scene._rooms):
             self._furnish(room_id, scene.clutter(room_id), movers=False)
         scene.listeners.append(self._furnish)
-        target = sim.target
+        self.target = target = sim.target
         if target.mover is None:
             w, d = (1.8, 0.6) if target.avatar.get("activity") == "laying" else (0.5, 0.5)
-            body = self.client.add_box(target.start, (w, d, 2 * 0.5))
-            self.names[body] = "target"
+            self.target_size = np.array([w, d, 2 * 0.5])
+            self.target_body = self.client.add_box(target.start, self.target_size)
+            self.names[self.target_body] = "target"
+        else:
+            self.target_size = np.asarray(target.mover.size, dtype=float)
+            self.target_body = next(b for m, b in self.movers if m is target.mover)
+
+    def target_now(self, now: float) -> tuple[int, FloatArray, FloatArray]:
+        """The target's body, centre and size now (a patrolling one is put there first)."""
+        if self.target.mover is None:
+            return self.target_body, np.asarray(self.target.start, dtype=float), self.target_size
+        centre = self.target.mover.position_at(now)
+        self.client.call("resetBasePositionAndOrientation", self.target_body, centre.tolist(),
+                         [0.0, 0.0, 0.0, 1.0])
+        return self.target_body, centre, self.target_size
 
     def _furnish(self, room_id: str, clutter: Clutter, movers: bool = True) -> None:
         still = self._scene.still_boxes([room_id])
@@ -173,6 +188,7 @@ class PhysicsCoSim:
         robot.begin(track, self.env.now)  # type: ignore[arg-type]
         done = self.env.event()
         self.active[robot.id] = (robot, track, done)
+        self.perception.moving(robot, done)
         if not self._wake.triggered:
             self._wake.succeed()
         return done
@@ -188,18 +204,12 @@ class PhysicsCoSim:
 
     def watch(self, robot: Robot, motion: Motion, sensor: GeometricSensor,
               done: simpy.Event) -> simpy.Event:
-        """Look for the target from where the body really is, at the log rate."""
-        return self.env.process(self._watch(robot, sensor, done))
+        """Look for the target in rendered frames while the body moves."""
+        return self.perception.watch(robot, done)
 
-    def _watch(self, robot: Robot, sensor: GeometricSensor,
-               done: simpy.Event) -> Generator[simpy.Event, Any, Sighting | None]:
-        track = robot.motion
-        while not done.triggered and robot.motion is track:
-            hit = sensor.sighting_from(robot, robot.position(self.env.now), self.env.now)
-            if hit is not None:
-                return hit
-            yield self.env.timeout(1.0 / self.spec.log_rate)
-        return None
+    def look(self, robot: Robot, sensor: GeometricSensor) -> Sighting | None:
+        """Render what the robot's camera sees from where it waits (around, if it pans)."""
+        return self.perception.look(robot)
 
     def close(self) -> None:
         self.client.close()

@@ -12,6 +12,7 @@ from astralis_des.world.geometry import FloatArray
 
 if TYPE_CHECKING:
     from astralis_des.kernel.handler import TaskHandler
+    from astralis_des.view import View
 
 
 @dataclass
@@ -78,16 +79,20 @@ class Motion:
         return self.profile.time_of(s)
 
     def heading_at(self, t: float, before: float) -> float:
-        """The heading after running until ``t``: that of the last leg begun."""
-        headings = self.profile.headings
-        if self.turn_rate is None or len(headings) == 0:
-            return before
+        """The heading after running until ``t``: that of the last leg begun that moves
+        horizontally (the turned-to heading for a robot that turns on the spot)."""
         s = float(self.profile.arc(t - self.t0))
         legs = np.flatnonzero(np.diff(self.cum) > 1e-9)
         begun = legs[self.cum[legs] <= s + 1e-9]
-        flat = [i for i, leg in enumerate(begun)
+        flat = [(i, int(leg)) for i, leg in enumerate(begun)
                 if np.hypot(*np.diff(self.points[[leg, leg + 1]], axis=0)[0][:2]) > 1e-6]
-        return float(headings[flat[-1]]) if flat else before
+        if not flat:
+            return before
+        headings = self.profile.headings
+        if self.turn_rate is not None and len(headings):
+            return float(headings[flat[-1][0]])
+        dx, dy = (self.points[flat[-1][1] + 1] - self.points[flat[-1][1]])[:2]
+        return float(np.arctan2(dy, dx))
 
     def vertices_until(self, t: float) -> tuple[FloatArray, FloatArray]:
         """Timed vertices passed by time ``t``, plus the pose at ``t``: ``(times, points)``."""
@@ -102,7 +107,7 @@ class Robot:
     id: str
     kind: str
     speed: float
-    detection_radius: float
+    view: View | None  # its camera's field of view; None: it carries no camera
     height: float
     pose: FloatArray
     handler: TaskHandler | None = None

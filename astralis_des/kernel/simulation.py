@@ -29,6 +29,8 @@ from astralis_des.mission.loader import Mission
 from astralis_des.mission.spec import MemberSpec
 from astralis_des.planning.navigator import Navigator
 from astralis_des.sensing import GeometricSensor, Sighting
+from astralis_des.streams import stream
+from astralis_des.view import View
 
 log = logging.getLogger(__name__)
 Progress = Callable[[float, float], None]
@@ -53,7 +55,8 @@ class Simulation:
                            movers=spec.scene.movers, mover_speed=spec.scene.mover_speed,
                            on_skipped=self._not_placed)
         self.target = draw_target(mission, self.scene)
-        self.sensor = GeometricSensor(self.scene, self.target)
+        self.sensor = GeometricSensor(self.scene, self.target,
+                                      stream(spec.seed, "sensing"))
         self.found = self.env.event()
         self.rounds: list[dict[str, Any]] = []
         self.searched: list[str] = []
@@ -87,9 +90,8 @@ class Simulation:
         else:
             start = np.array(member.start, dtype=float)
         start = start + np.array([0.0, 0.0, height])
-        robot = Robot(member.id, member.kind, member.speed or d.speed,
-                      member.detection_radius or d.detection_radius, height, start,
-                      accel=d.accel, turn_rate=d.turn_rate)
+        robot = Robot(member.id, member.kind, member.speed or d.speed, view_of(member),
+                      height, start, accel=d.accel, turn_rate=d.turn_rate)
         robot.trail_t.append(0.0)
         robot.trail_p.append(start.copy())
 
@@ -186,10 +188,12 @@ class Simulation:
     def report_detection(self, robot: Robot, sighting: Sighting) -> None:
         if self.found.triggered:
             return
-        self.log.emit("detection", robot.id, target_room=self.target.room,
+        extra = {"pixels": sighting.pixels} if sighting.pixels is not None else {}
+        self.log.emit("detection", robot.id, sensor="camera", target_room=self.target.room,
+                      estimate=sighting.estimate, error=sighting.error,
                       target_position=sighting.target_position,
                       robot_position=sighting.robot_position, distance=sighting.distance,
-                      avatar=self.target.avatar)
+                      **extra, avatar=self.target.avatar)
         self.found.succeed(robot.id)
 
     # -- running ---------------------------------------------------------------------------
@@ -262,6 +266,17 @@ class Simulation:
             self._sinks.close(result)
         log.info("%s: %s at t=%.1f s", self.mission.spec.name, outcome, self.env.now)
         return result
+
+
+def view_of(member: MemberSpec) -> View | None:
+    """The field of view of a member's camera: the mission's values, else its kind's."""
+    camera = member.sensor_set.camera
+    if camera is None:
+        return None
+    set_here = {k: v for k, v in (("range", camera.range), ("fov_deg", camera.fov_deg),
+                                  ("pitch_deg", camera.pitch_deg)) if v is not None}
+    return View.of_kind(member.kind, camera.width / camera.height,
+                        position_noise=camera.position_noise, **set_here)
 
 
 def _xyz(p: np.ndarray) -> tuple[float, float, float]:

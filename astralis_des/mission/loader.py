@@ -74,7 +74,24 @@ def load_mission(path: str | Path) -> Mission:
 
 def _validate(doc: LocatedYaml) -> MissionSpec:
     check_unique_ids(doc, "team")
-    return validate(MissionSpec, doc)
+    spec = validate(MissionSpec, doc)
+    _check_imu_rates(spec, doc)
+    return spec
+
+
+def _check_imu_rates(spec: MissionSpec, doc: LocatedYaml) -> None:
+    """An IMU reads the physics state at controller ticks: its period must be whole ticks."""
+    control = spec.physics.control_rate
+    for i, member in enumerate(spec.team):
+        imu = member.sensor_set.imu
+        if imu is None:
+            continue
+        ticks = control / imu.rate
+        if imu.rate > control or abs(ticks - round(ticks)) > 1e-9:
+            where: KeyPath = (("team", i, "sensors", "imu", "rate") if member.sensors is not None
+                              else ("physics", "control_rate"))
+            raise doc.error(where, f"the IMU of {member.id} reads at {imu.rate:g} Hz, which "
+                            f"does not divide the physics control_rate {control} Hz")
 
 
 def check_unique_ids(doc: LocatedYaml, key: str) -> None:

@@ -21,29 +21,44 @@ class Strict(BaseModel):
 
 
 class CameraSpec(Strict):
-    """A pinhole camera: RGB, depth and segmentation (physics), or its frustum (kinematic)."""
+    """A pinhole camera: RGB, depth and segmentation (physics), or its frustum (kinematic).
+
+    Unset geometry comes from the robot's kind (``astralis_des.kinds``)."""
 
     width: int = Field(320, gt=0, le=4096, description="pixels")
     height: int = Field(240, gt=0, le=4096, description="pixels")
-    fov_deg: float = Field(60.0, gt=0, lt=180, description="vertical field of view")
-    range: PositiveFloat = Field(8.0, description="m: farther than this is not detected")
-    pitch_deg: float = Field(0.0, ge=-90, le=90, description="0 forward, 90 straight down")
-    min_pixels: int = Field(40, ge=1, description="target pixels a detection needs")
+    fov_deg: float | None = Field(None, gt=0, lt=180, description="vertical field of view")
+    range: PositiveFloat | None = Field(None, description="m: farther is not detected")
+    pitch_deg: float | None = Field(None, ge=-90, le=90,
+                                    description="0 forward, 90 straight down")
+    min_pixels: int = Field(40, ge=1, description="target pixels a detection needs (physics)")
+    rate: PositiveFloat = Field(
+        4.0, le=60, description="looks per s while searching (physics): a frame is rendered "
+        "when the target's box may be in view, else the look costs a frustum test")
+    record_rate: NonNegativeFloat = Field(
+        0.5, le=10, description="frames per s kept for the recording, rendered at half "
+        "resolution (physics); 0: only the frame of a detection")
+    position_noise: NonNegativeFloat = Field(
+        0.03, description="kinematic fidelity: the estimate's error per axis, a share of the "
+        "distance (physics estimates from the depth pixels)")
 
 
 class LidarSpec(Strict):
-    """A 2-D lidar in the robot's horizontal plane."""
+    """A 2-D lidar in the robot's horizontal plane (physics fidelity)."""
 
     beams: int = Field(360, ge=1, le=4096)
     range: PositiveFloat = 30.0
-    rate: PositiveFloat = Field(10.0, description="scans per s")
+    rate: PositiveFloat = Field(10.0, le=60, description="scans per s while moving")
     noise_std: NonNegativeFloat = Field(0.01, description="m, range noise")
+    record_rate: NonNegativeFloat = Field(1.0, le=60, description="scans per s kept for the "
+                                          "recording")
 
 
 class ImuSpec(Strict):
-    """An IMU: specific force and angular rate, with noise and constant biases."""
+    """An IMU: specific force and angular rate, with noise and constant biases (physics)."""
 
-    rate: PositiveFloat = Field(100.0, description="readings per s")
+    rate: PositiveFloat = Field(20.0, description="readings per s while moving; must divide "
+                                "the physics control_rate")
     accel_noise: NonNegativeFloat = 0.02
     gyro_noise: NonNegativeFloat = 0.002
     accel_bias: Vec3 = (0.0, 0.0, 0.0)
@@ -51,15 +66,21 @@ class ImuSpec(Strict):
 
 
 class SensorsSpec(Strict):
+    """What a robot carries. A member without ``sensors`` gets its kind's set
+    (UAV: camera and IMU; UGV: camera, lidar and IMU; human: camera); one that names
+    sensors gets a camera unless ``camera: null``, and only the lidar and IMU it names."""
+
     camera: CameraSpec | None = Field(default_factory=CameraSpec)
     lidar: LidarSpec | None = None
     imu: ImuSpec | None = None
 
 
+SENSORS = ("camera", "lidar", "imu")
 # What each kind can carry: the human operator has eyes (a camera model) and nothing else.
 CARRIES: dict[str, tuple[str, ...]] = {
-    "uav": ("camera", "lidar", "imu"), "ugv": ("camera", "lidar", "imu"), "human": ("camera",),
+    "uav": SENSORS, "ugv": SENSORS, "human": ("camera",),
 }
+_DEFAULT_SPECS = {"camera": CameraSpec(), "lidar": LidarSpec(), "imu": ImuSpec()}
 
 
 class MemberSpec(Strict):
@@ -69,18 +90,28 @@ class MemberSpec(Strict):
     kind: Kind
     start: Vec3 | str = Field(description="[x, y, z] in metres, or a room id")
     speed: PositiveFloat | None = Field(None, description="m/s; default by kind")
-    detection_radius: PositiveFloat | None = Field(None, description="m; default by kind")
     height: PositiveFloat | None = Field(
         None, description="m above the floor of its sensor (UAV: flight altitude)")
-    sensors: SensorsSpec = Field(default_factory=SensorsSpec)
+    sensors: SensorsSpec | None = Field(None, description="default: the kind's sensor set")
 
     @model_validator(mode="after")
     def _can_carry(self) -> MemberSpec:
-        for name in ("camera", "lidar", "imu"):
-            if getattr(self.sensors, name) is not None and name not in CARRIES[self.kind]:
+        for name in SENSORS:
+            if self.sensors is not None and getattr(self.sensors, name) is not None \
+                    and name not in CARRIES[self.kind]:
                 raise ValueError(f"sensors.{name}: a {self.kind} cannot carry a {name}; it "
                                  f"carries: {', '.join(CARRIES[self.kind])}")
         return self
+
+    @property
+    def sensor_set(self) -> SensorsSpec:
+        """The sensors this member carries, its kind's set when the mission names none."""
+        if self.sensors is not None:
+            return self.sensors
+        from astralis_des.kinds import KIND_DEFAULTS
+
+        carried = KIND_DEFAULTS[self.kind].sensors
+        return SensorsSpec(**{n: _DEFAULT_SPECS[n] if n in carried else None for n in SENSORS})
 
 
 class RoomProps(Strict):

@@ -39,6 +39,7 @@ class Driver(Protocol):
     def freeze(self) -> None: ...
     def heading_vector(self) -> FloatArray: ...
     def avoid(self, hold: bool, shift: FloatArray) -> None: ...
+    def slow_down(self, share: float) -> None: ...
 
 
 DRIVERS: Registry[str, type] = Registry("driver")
@@ -58,6 +59,9 @@ class Avoiding:
 
     def avoid(self, hold: bool, shift: FloatArray) -> None:
         self.held, self.shift_to = hold, np.asarray(shift, dtype=float)
+
+    def slow_down(self, share: float) -> None:
+        """Obstacles ahead (the lidar): go at most ``share`` of the speed. Only a UGV does."""
 
 
 @DRIVERS.register("uav")
@@ -216,6 +220,9 @@ class UgvDriver(Avoiding):
                 return "arrived"
             self._next_leg(t)
         return None
+
+    def slow_down(self, share: float) -> None:
+        self.husky.limit = share * self.speed if share < 1.0 else math.inf
 
     def position(self) -> FloatArray:
         x, y, _, _ = self.husky.pose()

@@ -43,6 +43,7 @@ class Husky:
         self.cum: FloatArray = np.zeros(1)
         self.progress = 0.0
         self.speed = 1.0
+        self.limit = math.inf  # m/s: a cap the local planner sets (obstacles ahead)
         self.offset = np.zeros(2)  # shift of the pursued point (keeping right)
         self.drive(0.0, 0.0)
 
@@ -120,7 +121,7 @@ class Husky:
             return False
         distance = max(math.hypot(gx - x, gy - y), 1e-3)
         braking = math.sqrt(2.0 * DECEL * remaining)  # stop at the end, not before it
-        speed = min(self.speed, braking) * max(math.cos(alpha), 0.2)
+        speed = min(self.speed, braking, self.limit) * max(math.cos(alpha), 0.2)
         turn = max(-MAX_TURN_RATE, min(MAX_TURN_RATE, 2.0 * speed * math.sin(alpha) / distance))
         self.drive(speed, turn)
         return False

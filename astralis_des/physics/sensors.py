@@ -100,7 +100,11 @@ class Frame:
 
     def points_of(self, body: int) -> FloatArray:
         """``(N, 3)`` world points of ``body``'s pixels, back-projected from the depth."""
-        rows, cols = np.nonzero(self.segmentation == body)
+        return self.points_where(self.segmentation == body)
+
+    def points_where(self, mask: NDArray[np.bool_]) -> FloatArray:
+        """``(N, 3)`` world points of the pixels in ``mask``, back-projected from the depth."""
+        rows, cols = np.nonzero(mask)
         k, z = self.intrinsics, self.depth[rows, cols]
         camera = np.column_stack([(cols + self.pixel_centre[0] - k.cx) * z / k.fx,
                                   (rows + self.pixel_centre[1] - k.cy) * z / k.fy, z])
@@ -135,14 +139,18 @@ class Camera:
                 index = per_link[shape[1]] = per_link.get(shape[1], -1) + 1
                 self._visuals.append((shape[1], index, list(shape[7])))
 
-    def pose(self) -> tuple[FloatArray, FloatArray]:
-        """Eye position and rotation world_from_camera, from the body's current pose."""
+    def pose(self, yaw: float | None = None) -> tuple[FloatArray, FloatArray]:
+        """Eye position and rotation world_from_camera, from the body's current pose; with
+        ``yaw``, on a gimbal: levelled and turned to that heading, the mount turned with it."""
         position, rotation = _body_pose(self.client, self.body)
+        if yaw is not None:
+            c, s = math.cos(yaw), math.sin(yaw)
+            rotation = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
         return position + rotation @ self.mount, rotation @ self.body_from_camera
 
-    def capture(self, time: float = 0.0) -> Frame:
+    def capture(self, time: float = 0.0, yaw: float | None = None) -> Frame:
         """Render the view now; the camera's own body is hidden so that it never blocks it."""
-        eye, rotation = self.pose()
+        eye, rotation = self.pose(yaw)
         view = self.client.call("computeViewMatrix", eye.tolist(), (eye + rotation[:, 2]).tolist(),
                                 (-rotation[:, 1]).tolist())
         k = self.intrinsics

@@ -1,0 +1,277 @@
+"""The sensors at work in the physics fidelity, each a SimPy process or an on-demand call.
+
+- **Cameras** look ``rate`` times a second while an action searches, and once (around, for a
+  camera that pans) when a robot waits in place. A look first tests whether the target's box
+  lies in the camera's frustum and range at all (microseconds); only then is a frame rendered
+  (about 30 ms at 320 x 240), and the target is detected when at least ``min_pixels`` of its
+  segmentation lie within range. The estimate is the centroid of those pixels' depth points.
+  Frames are kept for the recording at ``record_rate``, rendered at half resolution.
+- **Lidars** scan at their rate while their robot moves; a UGV slows down for the nearest
+  return ahead of it (the local planner's safety bubble).
+- **IMUs** read at their rate while their robot moves.
+
+Every sensor's wall time and calls are counted (:class:`SensorClock`) for the benchmark.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Generator, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import simpy
+from numpy.typing import NDArray
+
+from astralis_des.kernel.robot import Robot
+from astralis_des.mission.spec import CameraSpec, ImuSpec, LidarSpec
+from astralis_des.physics.sensors import Camera, Frame, Imu, ImuReading, Intrinsics, Lidar2D
+from astralis_des.sensing import Sighting
+from astralis_des.streams import stream
+from astralis_des.view import View, look_headings
+from astralis_des.world.geometry import FloatArray
+
+if TYPE_CHECKING:
+    from astralis_des.cosim.physics import PhysicsCoSim
+    from astralis_des.kernel.simulation import Simulation
+
+AHEAD = math.radians(25.0)  # half-angle of the lidar sector a UGV slows down for
+SLOW_AT = 1.5  # m from the lidar: nearer than this ahead, a UGV slows down ...
+STOP_AT = 0.7  # m: ... to CREEP of its speed here
+CREEP = 0.3
+LIDAR_OFFSET = {"ugv": 0.6, "uav": 0.5}  # m: rays start outside the body
+
+
+@dataclass
+class SensorClock:
+    """Wall seconds and calls per sensor."""
+
+    seconds: dict[str, float] = field(default_factory=dict)
+    calls: dict[str, int] = field(default_factory=dict)
+
+    @contextmanager
+    def timed(self, name: str) -> Iterator[None]:
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.seconds[name] = self.seconds.get(name, 0.0) + time.perf_counter() - t0
+            self.calls[name] = self.calls.get(name, 0) + 1
+
+
+@dataclass(frozen=True)
+class KeptFrame:
+    """A camera frame kept for the recording (half resolution)."""
+
+    robot: str
+    time: float
+    rgb: NDArray[np.uint8]
+    depth: NDArray[np.float32]  # metres; 0 where nothing was rendered
+    segmentation: NDArray[np.uint16]  # body id + 1; 0 where nothing was rendered
+    eye: FloatArray
+    rotation: FloatArray  # world_from_camera
+    intrinsics: Intrinsics
+    detection: bool
+
+
+@dataclass(frozen=True)
+class KeptScan:
+    robot: str
+    time: float
+    points: FloatArray  # (M, 3): the returns only
+
+
+@dataclass
+class ImuTrace:
+    times: list[float] = field(default_factory=list)
+    readings: list[ImuReading] = field(default_factory=list)
+
+
+class Eyes:
+    """A robot's camera: full resolution to detect, half to keep frames."""
+
+    def __init__(self, cosim: PhysicsCoSim, robot: Robot, spec: CameraSpec, view: View) -> None:
+        body = cosim.drivers[robot.id].body
+        mount = _mount(cosim, robot.id)
+        self.spec, self.view = spec, view
+        k = Intrinsics(spec.width, spec.height, view.fov_deg, far=view.range + 1.0)
+        self.full = Camera(cosim.client, body, k, mount, view.pitch_deg)
+        small = Intrinsics(max(spec.width // 2, 1), max(spec.height // 2, 1), view.fov_deg,
+                           far=view.range + 1.0)
+        self.small = Camera(cosim.client, body, small, mount, view.pitch_deg)
+        self.next_keep = 0.0
+
+
+class Perception:
+    """Cameras, lidars and IMUs of a physics run."""
+
+    def __init__(self, cosim: PhysicsCoSim, sim: Simulation) -> None:
+        self.cosim, self.env = cosim, sim.env
+        self.clock = SensorClock()
+        self.frames: list[KeptFrame] = []
+        self.scans: list[KeptScan] = []
+        self.imu_traces: dict[str, ImuTrace] = {}
+        self.eyes: dict[str, Eyes] = {}
+        self.lidars: dict[str, tuple[Lidar2D, LidarSpec]] = {}
+        self.imus: dict[str, tuple[Imu, ImuSpec]] = {}
+        seed = sim.mission.spec.seed
+        for index, member in enumerate(sim.mission.spec.team):
+            robot, sensors = sim.robots[member.id], member.sensor_set
+            body = cosim.drivers[member.id].body
+            if sensors.camera is not None and robot.view is not None:
+                self.eyes[member.id] = Eyes(cosim, robot, sensors.camera, robot.view)
+            if sensors.lidar is not None:
+                spec = sensors.lidar
+                self.lidars[member.id] = (Lidar2D(
+                    cosim.client, body, _mount(cosim, member.id), spec.beams, spec.range,
+                    noise_std=spec.noise_std, rng=stream(seed, "sensing", 1, index),
+                    start_offset=LIDAR_OFFSET.get(member.kind, 0.5)), spec)
+            if sensors.imu is not None:
+                spec_i = sensors.imu
+                self.imus[member.id] = (Imu(
+                    cosim.client, body, spec_i.accel_noise, spec_i.gyro_noise,
+                    spec_i.accel_bias, spec_i.gyro_bias, stream(seed, "sensing", 2, index)),
+                    spec_i)
+                self.imu_traces[member.id] = ImuTrace()
+
+    # -- cameras -----------------------------------------------------------------------------
+    def watch(self, robot: Robot, done: simpy.Event) -> simpy.Process:
+        """A process that looks ahead while ``robot`` moves; its value is the first
+        sighting, or None when the motion ends unseen."""
+        return self.env.process(self._watch(robot, done))
+
+    def _watch(self, robot: Robot,
+               done: simpy.Event) -> Generator[simpy.Event, Any, Sighting | None]:
+        eyes = self.eyes.get(robot.id)
+        if eyes is None:
+            return None
+        track = robot.motion
+        while not done.triggered and robot.motion is track:
+            hit = self._look(robot, eyes, [self._travel_yaw(robot, eyes)])
+            if hit is not None:
+                return hit
+            yield self.env.timeout(1.0 / eyes.spec.rate)
+        return None
+
+    def look(self, robot: Robot) -> Sighting | None:
+        """One look from where the robot waits: around, for a camera that pans."""
+        eyes = self.eyes.get(robot.id)
+        if eyes is None:
+            return None
+        if not eyes.view.gimbal:
+            return self._look(robot, eyes, [None])
+        return self._look(robot, eyes, list(look_headings(eyes.view, robot.heading)))
+
+    def _travel_yaw(self, robot: Robot, eyes: Eyes) -> float | None:
+        """A gimbal turns to the direction of travel (kept while hovering); a body camera
+        turns with the body (None)."""
+        if not eyes.view.gimbal:
+            return None
+        ahead = self.cosim.drivers[robot.id].heading_vector()
+        if float(np.hypot(*ahead)) > 1e-3:
+            robot.heading = math.atan2(float(ahead[1]), float(ahead[0]))
+        return robot.heading
+
+    def _look(self, robot: Robot, eyes: Eyes, yaws: list[float | None]) -> Sighting | None:
+        now = self.env.now
+        if eyes.spec.record_rate > 0 and now >= eyes.next_keep:
+            eyes.next_keep = now + 1.0 / eyes.spec.record_rate
+            with self.clock.timed("camera"):
+                self._keep(robot.id, eyes.small.capture(now, yaws[0]), detection=False)
+        body, centre, size = self.cosim.target_now(now)
+        corners = centre + np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5])
+                                    ).reshape(3, -1).T * np.asarray(size)
+        probe = np.vstack([centre[None, :], corners])
+        for yaw in yaws:
+            with self.clock.timed("camera_cull"):
+                eye, rotation = eyes.full.pose(yaw)
+                heading = math.atan2(rotation[1, 2], rotation[0, 2])
+                inside = eyes.view.sees(np.repeat(eye[None, :], len(probe), axis=0),
+                                        np.full(len(probe), heading), probe)
+            if not inside.any():
+                continue
+            with self.clock.timed("camera"):
+                frame = eyes.full.capture(now, yaw)
+                hit = self._detect(frame, body, eyes, centre)
+            if hit is not None:
+                self._keep(robot.id, frame, detection=True, step=2)
+                return hit
+        return None
+
+    def _detect(self, frame: Frame, body: int, eyes: Eyes, centre: FloatArray) -> Sighting | None:
+        mask = (frame.segmentation == body) & (frame.depth <= eyes.view.range)
+        pixels = int(np.count_nonzero(mask))
+        if pixels < eyes.spec.min_pixels:
+            return None
+        estimate = frame.points_where(mask).mean(axis=0)
+        eye = frame.pose[0]
+        return Sighting(0.0, _xyz(eye), _xyz(centre), float(np.linalg.norm(centre - eye)),
+                        _xyz(estimate), float(np.linalg.norm(estimate - centre)), pixels)
+
+    def _keep(self, robot_id: str, frame: Frame, detection: bool, step: int = 1) -> None:
+        k = frame.intrinsics
+        small = Intrinsics(k.width // step, k.height // step, k.fov_deg, k.near, k.far)
+        depth = frame.depth[::step, ::step].astype(np.float32)
+        depth[~np.isfinite(depth)] = 0.0
+        segmentation = (frame.segmentation[::step, ::step] + 1).astype(np.uint16)
+        self.frames.append(KeptFrame(robot_id, frame.time, frame.rgb[::step, ::step].copy(),
+                                     depth, segmentation, frame.pose[0], frame.pose[1], small,
+                                     detection))
+
+    # -- lidars and IMUs ---------------------------------------------------------------------
+    def moving(self, robot: Robot, done: simpy.Event) -> None:
+        """Start the robot's lidar and IMU for a motion that ends with ``done``."""
+        if robot.id in self.lidars:
+            self.env.process(self._scan(robot, done))
+        if robot.id in self.imus:
+            self.env.process(self._read(robot, done))
+
+    def _scan(self, robot: Robot, done: simpy.Event) -> Generator[simpy.Event, Any, None]:
+        lidar, spec = self.lidars[robot.id]
+        driver = self.cosim.drivers[robot.id]
+        keep_every = max(1, round(spec.rate / spec.record_rate)) if spec.record_rate else 0
+        count = 0
+        while not done.triggered:
+            with self.clock.timed("lidar"):
+                scan = lidar.scan(self.env.now)
+                ahead = np.abs(scan.angles) <= AHEAD
+                nearest = float(scan.ranges[ahead].min()) if ahead.any() else math.inf
+            share = min(max((nearest - STOP_AT) / (SLOW_AT - STOP_AT), CREEP), 1.0)
+            driver.slow_down(share)
+            if keep_every and count % keep_every == 0:
+                hits = scan.points[np.isfinite(scan.ranges)]
+                self.scans.append(KeptScan(robot.id, self.env.now, hits))
+            count += 1
+            yield self.env.timeout(1.0 / spec.rate) | done
+        driver.slow_down(1.0)
+
+    def _read(self, robot: Robot, done: simpy.Event) -> Generator[simpy.Event, Any, None]:
+        imu, spec = self.imus[robot.id]
+        trace = self.imu_traces[robot.id]
+        imu._velocity = None  # a new motion: no difference across the pause before it
+        last = self.cosim.t
+        while not done.triggered:
+            yield self.env.timeout(1.0 / spec.rate) | done
+            dt = self.cosim.t - last
+            if dt <= 1e-9 or done.triggered:
+                continue
+            last = self.cosim.t
+            with self.clock.timed("imu"):
+                trace.readings.append(imu.read(dt, self.env.now))
+            trace.times.append(self.env.now)
+
+
+def _mount(cosim: PhysicsCoSim, robot_id: str) -> FloatArray:
+    """Where the robot's sensors sit in its body frame: at the pose the fidelity reports."""
+    driver = cosim.drivers[robot_id]
+    base, quat = cosim.client.call("getBasePositionAndOrientation", driver.body)
+    rotation = np.array(cosim.client.call("getMatrixFromQuaternion", quat)).reshape(3, 3)
+    out: FloatArray = rotation.T @ (driver.position() - np.asarray(base))
+    return out
+
+
+def _xyz(p: FloatArray) -> tuple[float, float, float]:
+    return (float(p[0]), float(p[1]), float(p[2]))

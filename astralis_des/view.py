@@ -1,0 +1,119 @@
+"""A camera's field of view as the geometric sensing model sees it, and where it looks.
+
+The camera frame is the computer-vision one: x right, y down, z forward along the optical
+axis. A heading is the yaw of the camera's forward axis, counter-clockwise from +x.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property, lru_cache
+
+import numpy as np
+
+from astralis_des.world.geometry import FloatArray
+
+LOOK_AROUND = 8  # headings a camera that pans a full turn looks along
+
+
+@dataclass(frozen=True)
+class View:
+    """A pinhole camera's field of view on a robot: what the geometric model checks."""
+
+    range: float  # m
+    fov_deg: float  # vertical
+    aspect: float  # width / height: square pixels give the horizontal field of view
+    pitch_deg: float  # 0 forward, 90 straight down
+    gimbal: bool = True  # levelled, turned to the direction of travel
+    look_around: bool = False  # pans a full turn while waiting in place
+    position_noise: float = 0.0  # the estimate's error per axis, a share of the distance
+
+    @classmethod
+    def of_kind(cls, kind: str, aspect: float = 4 / 3, **changes: float) -> View:
+        """A kind's default camera (``astralis_des.kinds``), with ``changes``."""
+        from astralis_des.kinds import KIND_DEFAULTS
+
+        d = KIND_DEFAULTS[kind].camera
+        values: dict[str, float] = {"range": d.range, "fov_deg": d.fov_deg,
+                                    "pitch_deg": d.pitch_deg, **changes}
+        return cls(values["range"], values["fov_deg"], aspect, values["pitch_deg"],
+                   gimbal=d.gimbal, look_around=d.look_around,
+                   position_noise=values.get("position_noise", 0.0))
+
+    @cached_property
+    def tan_v(self) -> float:
+        return math.tan(math.radians(self.fov_deg) / 2)
+
+    @cached_property
+    def tan_h(self) -> float:
+        return self.tan_v * self.aspect
+
+    def axes(self, headings: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Camera right, down and forward unit vectors in the world, one row per heading."""
+        h = np.asarray(headings, dtype=float)
+        p = math.radians(self.pitch_deg)
+        forward = np.column_stack([math.cos(p) * np.cos(h), math.cos(p) * np.sin(h),
+                                   np.full(h.shape, -math.sin(p))])
+        right = np.column_stack([np.sin(h), -np.cos(h), np.zeros(h.shape)])
+        return right, np.cross(forward, right), forward
+
+    def sees(self, eyes: FloatArray, headings: FloatArray, points: FloatArray) -> FloatArray:
+        """Which ``points`` are in range and in the frustum of the camera at ``eyes`` facing
+        ``headings`` (row by row; sight lines are not checked)."""
+        d = np.asarray(points, dtype=float) - np.asarray(eyes, dtype=float)
+        right, down, forward = self.axes(headings)
+        z = np.einsum("ij,ij->i", d, forward)
+        x = np.abs(np.einsum("ij,ij->i", d, right))
+        y = np.abs(np.einsum("ij,ij->i", d, down))
+        near = np.einsum("ij,ij->i", d, d) <= self.range**2
+        result: FloatArray = near & (z > 1e-6) & (x <= z * self.tan_h) & (y <= z * self.tan_v)
+        return result
+
+    def swath(self, drop: float) -> float:
+        """Width across the direction of travel of what the camera sees on a plane ``drop``
+        metres below it (to 1 cm): moving ahead, it sweeps a strip this wide."""
+        return _swath(self, round(drop, 3))
+
+
+@lru_cache(maxsize=64)
+def _swath(view: View, drop: float) -> float:
+    steps = int(2 * view.range / 0.01) + 1
+    xs = np.linspace(-view.range, view.range, steps)
+    widths = []
+    for x in xs[::4]:  # rows across the track, 4 cm apart along it
+        pts = np.column_stack([np.full(steps, x), xs, np.full(steps, -drop)])
+        seen = view.sees(np.zeros((steps, 3)), np.zeros(steps), pts)
+        if seen.any():
+            widths.append(xs[seen])
+    if not widths:
+        return 0.0
+    ys = np.concatenate(widths)
+    return float(ys.max() - ys.min())
+
+
+def travel_headings(points: FloatArray, initial: float) -> FloatArray:
+    """The heading of travel at each point (that of the leg leaving it; the last leg's at the
+    end); where the path does not move horizontally, the heading before."""
+    pts = np.asarray(points, dtype=float)
+    legs = np.diff(pts[:, :2], axis=0)
+    moving = np.hypot(legs[:, 0], legs[:, 1]) > 1e-6
+    out = np.full(len(pts), initial, dtype=float)
+    if not moving.any():
+        return out
+    angle = np.arctan2(legs[:, 1], legs[:, 0])
+    last = np.maximum.accumulate(np.where(moving, np.arange(len(legs)), -1))
+    ahead = np.where(last >= 0, angle[np.maximum(last, 0)], initial)
+    out[:-1] = ahead
+    out[-1] = ahead[-1]
+    return out
+
+
+def look_headings(view: View, heading: float) -> FloatArray:
+    """Where a waiting camera looks: a full turn for one that pans, else straight ahead."""
+    if not view.look_around:
+        return np.array([heading])
+    out: FloatArray = heading + np.arange(LOOK_AROUND, dtype=float) * (2 * math.pi / LOOK_AROUND)
+    return out
+
+
