@@ -138,6 +138,22 @@ def test_lidar_ranges_to_a_wall_match_its_distance(client: PhysicsClient) -> Non
     assert np.isinf(scan.ranges[np.abs(scan.angles) > np.pi / 2]).all()
 
 
+def test_lidar_reads_beyond_its_first_pass(client: PhysicsClient) -> None:
+    """A scan casts to 5 m, then on for the beams that found nothing: a wall 12 m ahead
+    (face at 11.9 m) and one 2 m behind (face at 1.9 m) both read right; the far wall's
+    ids are its body's."""
+    body = robot(client, SPOT)
+    far = client.add_box(SPOT + (12.0, 0.0, 0.0), (0.2, 4.0, 2.0))
+    client.add_box(SPOT - (2.0, 0.0, 0.0), (0.2, 4.0, 2.0))
+    scan = Lidar2D(client, body, noise_std=0.0).scan()
+    ahead = int(np.argmin(np.abs(scan.angles)))
+    behind = int(np.argmin(np.abs(np.abs(scan.angles) - np.pi)))
+    assert scan.ranges[ahead] == pytest.approx(11.9, abs=0.03) and scan.hit_ids[ahead] == far
+    assert scan.ranges[behind] == pytest.approx(1.9, abs=0.03)
+    assert Lidar2D(client, body, noise_std=0.0, near=30.0).scan().ranges == pytest.approx(
+        scan.ranges, abs=1e-4, nan_ok=True)
+
+
 def test_lidar_beams_turn_with_the_heading(client: PhysicsClient) -> None:
     """Turned 90 deg left, the wall that was ahead is at angle -90 deg (on the right)."""
     body = robot(client, SPOT)

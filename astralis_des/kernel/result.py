@@ -41,7 +41,9 @@ class RunResult:
     rooms_searched: list[str]
     coverage: dict[str, float]
     events: list[Record] = field(repr=False)
+    sensor_calls: dict[str, int] = field(default_factory=dict)  # physics: looks, renders, scans
     wall_time: float = 0.0
+    sensor_time: dict[str, float] = field(default_factory=dict)  # wall s per sensor (physics)
 
     @property
     def found(self) -> bool:
@@ -56,6 +58,7 @@ class RunResult:
         data = asdict(self)
         data.pop("events")
         data.pop("wall_time")
+        data.pop("sensor_time")
         summary: dict[str, Any] = plain(data)
         return summary
 
@@ -74,10 +77,13 @@ def build_result(sim: Simulation, outcome: str, wall_time: float) -> RunResult:
     detection = next((r for r in sim.log.records if r["kind"] == "detection"), None)
     target = {"room": sim.target.room, "position": list(sim.target.position),
               **sim.target.avatar}
+    clock = getattr(getattr(sim.cosim, "perception", None), "clock", None)
     return RunResult(
         mission=sim.mission.spec.name, seed=sim.mission.spec.seed,
         fidelity=sim.mission.spec.fidelity, outcome=outcome, end_time=now,
         time_to_find=detection["t"] if detection else None,
         found_by=detection["robot"] if detection else None, target=target, robots=stats,
         rounds=sim.rounds, rooms_searched=list(sim.searched), coverage=coverage,
-        events=sim.log.records, wall_time=wall_time)
+        events=sim.log.records, wall_time=wall_time,
+        sensor_calls=dict(sorted(clock.calls.items())) if clock else {},
+        sensor_time=dict(sorted(clock.seconds.items())) if clock else {})

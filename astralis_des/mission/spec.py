@@ -57,8 +57,8 @@ class LidarSpec(Strict):
 class ImuSpec(Strict):
     """An IMU: specific force and angular rate, with noise and constant biases (physics)."""
 
-    rate: PositiveFloat = Field(20.0, description="readings per s while moving; must divide "
-                                "the physics control_rate")
+    rate: PositiveFloat = Field(20.0, description="readings per s while moving, rounded to "
+                                "whole controller ticks; at most the physics control_rate")
     accel_noise: NonNegativeFloat = 0.02
     gyro_noise: NonNegativeFloat = 0.002
     accel_bias: Vec3 = (0.0, 0.0, 0.0)

@@ -88,6 +88,7 @@ class UavDriver(Avoiding):
         self.end = t + motion.duration
         pos, vel = motion.sample(np.asarray(t + ticks * self.period, dtype=float))
         self.ref_pos, self.ref_vel = pos.tolist(), vel.tolist()
+        self.ref_acc = _acceleration(vel, self.period, motion.accel).tolist()
         self.goal = pos[-1]
         self.k = 0  # the reference's clock, in ticks: it stops while the robot holds
         self._clear_avoidance()
@@ -110,7 +111,10 @@ class UavDriver(Avoiding):
         self.shift = _ramp(self.shift, self.shift_to, SHIFT_RATE * self.period)
         ref = self.ref_pos[k]
         target = (ref[0] + self.shift[0], ref[1] + self.shift[1], ref[2])
-        self.craft.control(target, (0.0, 0.0, 0.0) if self.held else self.ref_vel[k])
+        if self.held:
+            self.craft.control(target, (0.0, 0.0, 0.0))
+        else:
+            self.craft.control(target, self.ref_vel[k], a_ref=self.ref_acc[k])
         return None
 
     def position(self) -> FloatArray:
@@ -268,6 +272,18 @@ class HumanDriver(Avoiding):
 
     def freeze(self) -> None:
         """A walker is kinematic: standing still costs nothing."""
+
+
+def _acceleration(velocity: FloatArray, period: float, limit: float | None) -> FloatArray:
+    """The reference's acceleration at each tick (central differences), capped at the
+    profile's: a corner's sudden turn of the velocity would otherwise ask for a kick."""
+    if len(velocity) < 2 or not limit:
+        return np.zeros_like(velocity)
+    acc = np.gradient(velocity, period, axis=0)
+    acc[-1] = 0.0  # the reference rests at its end: holding there needs no push
+    norm = np.linalg.norm(acc, axis=1, keepdims=True)
+    out: FloatArray = acc * np.minimum(1.0, limit / np.maximum(norm, 1e-12))
+    return out
 
 
 def _ramp(current: FloatArray, target: FloatArray, step: float) -> FloatArray:

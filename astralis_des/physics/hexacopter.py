@@ -88,7 +88,8 @@ class Hexacopter:
         pos, _ = self.client.call("getBasePositionAndOrientation", self.body)
         return np.array(pos)
 
-    def control(self, p_ref: Vec, v_ref: Vec, yaw_ref: float = 0.0) -> None:
+    def control(self, p_ref: Vec, v_ref: Vec, yaw_ref: float = 0.0,
+                a_ref: Vec = (0.0, 0.0, 0.0)) -> None:
         """One controller update; the rotor forces hold until the next one.
 
         Written on plain floats: for 3-vectors, numpy's call overhead costs more than the
@@ -106,7 +107,11 @@ class Hexacopter:
         if speed > self.max_speed:
             k = self.max_speed / speed
             dx, dy, dz = dx * k, dy * k, dz * k
-        ax, ay, az = KV * (dx - vx), KV * (dy - vy), KV * (dz - vz)
+        # the reference's own acceleration, fed forward: without it a cascade of two
+        # proportional loops lags a reference speeding up at a by a / (KP_POS * KV) metres
+        ax = a_ref[0] + KV * (dx - vx)
+        ay = a_ref[1] + KV * (dy - vy)
+        az = a_ref[2] + KV * (dz - vz)
         horizontal = math.hypot(ax, ay)
         if horizontal > self.max_horizontal:
             k = self.max_horizontal / horizontal

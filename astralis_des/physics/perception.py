@@ -253,8 +253,9 @@ class Perception:
         trace = self.imu_traces[robot.id]
         imu._velocity = None  # a new motion: no difference across the pause before it
         last = self.cosim.t
+        ticks = max(1, round(1.0 / (spec.rate * self.cosim.period)))
         while not done.triggered:
-            yield self.env.timeout(1.0 / spec.rate) | done
+            yield self.env.timeout(ticks * self.cosim.period) | done
             dt = self.cosim.t - last
             if dt <= 1e-9 or done.triggered:
                 continue

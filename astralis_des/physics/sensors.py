@@ -197,7 +197,7 @@ class Lidar2D:
     def __init__(self, client: PhysicsClient, body: int, mount: Vec3 = (0.0, 0.0, 0.0),
                  beams: int = 360, range_max: float = 30.0, range_min: float = 0.1,
                  noise_std: float = 0.01, rng: np.random.Generator | None = None,
-                 start_offset: float = 0.5) -> None:
+                 start_offset: float = 0.5, near: float = 5.0) -> None:
         _need_rng(noise_std, rng, "Lidar2D")
         if not 0 <= start_offset < range_max:
             raise ValueError(f"start_offset {start_offset} m must lie in [0, range_max)")
@@ -205,6 +205,7 @@ class Lidar2D:
         self.mount = np.asarray(mount, dtype=float)
         self.range_max, self.range_min, self.noise_std = range_max, range_min, noise_std
         self.start_offset = start_offset
+        self.near = near  # m: the first pass's reach (see ``scan``)
         self.angles: FloatArray = np.linspace(-math.pi, math.pi, beams, endpoint=False)
         self._warn_if_inside()
 
@@ -227,14 +228,25 @@ class Lidar2D:
         return position + rotation @ self.mount, directions
 
     def scan(self, time: float = 0.0) -> Scan:
-        """Cast every beam once (one ``rayTestBatch``) and add range noise to the returns."""
+        """Cast every beam and add range noise to the returns.
+
+        Two passes of ``rayTestBatch``: every beam to ``near`` metres, then the beams that
+        found nothing on from there. A ray's cost grows with the bounding boxes it crosses, so
+        indoors, where most beams end on a wall within a few metres, this costs about a third
+        less than full-length rays (measured in building A; the closest hit is the same)."""
         centre, directions = self._frame()
+        near = min(max(self.near, self.start_offset), self.range_max)
         starts = centre + self.start_offset * directions
-        ends = centre + self.range_max * directions
-        hits = self.client.call("rayTestBatch", starts.tolist(), ends.tolist())
+        middle = centre + near * directions
+        hits = self.client.call("rayTestBatch", starts.tolist(), middle.tolist())
         ids = np.array([h[0] for h in hits], dtype=np.int32)
-        fraction = np.array([h[2] for h in hits])
-        ranges = self.start_offset + fraction * (self.range_max - self.start_offset)
+        ranges = self.start_offset + np.array([h[2] for h in hits]) * (near - self.start_offset)
+        beyond = np.flatnonzero(ids < 0)
+        if len(beyond) and near < self.range_max:
+            ends = centre + self.range_max * directions[beyond]
+            more = self.client.call("rayTestBatch", middle[beyond].tolist(), ends.tolist())
+            ids[beyond] = [h[0] for h in more]
+            ranges[beyond] = near + np.array([h[2] for h in more]) * (self.range_max - near)
         if self.noise_std > 0 and self.rng is not None:
             # drawn for every beam, so that the stream does not depend on what was hit
             ranges = ranges + self.rng.normal(0.0, self.noise_std, len(ranges))

@@ -32,3 +32,18 @@ def robot_task(robot_id: str) -> str:
 
 def mover(mover_id: str) -> str:
     return "world/movers/" + mover_id.replace(":", "_")
+
+
+def robot_camera(robot_id: str) -> str:
+    return f"robots/{robot_id}/camera"
+
+
+def robot_lidar(robot_id: str) -> str:
+    return f"robots/{robot_id}/lidar"
+
+
+def robot_imu(robot_id: str, what: str) -> str:
+    return f"robots/{robot_id}/imu/{what}"
+
+
+MISSION_DETECTIONS = "mission/detections"

@@ -11,6 +11,7 @@ import numpy as np
 
 from astralis_des.kernel.events import LEVELS, Record
 from astralis_des.sinks import paths
+from astralis_des.sinks.sensor_log import log_detections, log_sensors
 from astralis_des.world.clutter import Placed
 from astralis_des.world.model import World
 
@@ -109,6 +110,10 @@ class RerunRecorder:
             rec.log(paths.WORLD_OCCUPANCY, rr.Points3D(points, radii=0.1, colors=colors),
                     static=True)
         self._log_movers(result.end_time)
+        perception = getattr(self.sim.cosim, "perception", None)
+        if perception is not None:
+            log_sensors(rr, rec, perception)
+        log_detections(rr, rec, self.sim.log.records)
         for entity, column in self._texts.items():
             rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE,
                                                             duration=column.times)],

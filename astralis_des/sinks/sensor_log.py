@@ -1,0 +1,80 @@
+"""What the sensors saw, in the recording: kept camera frames (RGB, depth, segmentation) under
+a pinhole that moves with the camera, lidar returns, IMU readings, and the detections (the
+estimate, and an arrow from the robot to it). Poses, points and readings go in columns."""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from astralis_des.kernel.events import Record
+from astralis_des.sinks import paths
+
+if TYPE_CHECKING:
+    from astralis_des.physics.perception import KeptFrame, Perception
+
+
+def log_sensors(rr: Any, rec: Any, perception: Perception) -> None:
+    by_robot: dict[str, list[KeptFrame]] = defaultdict(list)
+    for frame in perception.frames:
+        by_robot[frame.robot].append(frame)
+    for rid, frames in by_robot.items():
+        _log_frames(rr, rec, paths.robot_camera(rid), frames)
+    scans: dict[str, list[Any]] = defaultdict(list)
+    for scan in perception.scans:
+        scans[scan.robot].append(scan)
+    for rid, kept in scans.items():
+        points = np.vstack([s.points for s in kept]) if kept else np.zeros((0, 3))
+        rec.send_columns(paths.robot_lidar(rid),
+                         indexes=[rr.TimeColumn(paths.TIMELINE, duration=[s.time for s in kept])],
+                         columns=rr.Points3D.columns(positions=points).partition(
+                             [len(s.points) for s in kept]))
+        rec.log(paths.robot_lidar(rid), rr.Points3D.from_fields(radii=0.03,
+                                                                colors=[(255, 90, 90)]),
+                static=True)
+    for rid, trace in perception.imu_traces.items():
+        if not trace.times:
+            continue
+        index = [rr.TimeColumn(paths.TIMELINE, duration=trace.times)]
+        for what, values in (("specific_force", [r.specific_force for r in trace.readings]),
+                             ("angular_rate", [r.angular_rate for r in trace.readings])):
+            rows = np.asarray(values, dtype=float)
+            rec.send_columns(paths.robot_imu(rid, what), indexes=index,
+                             columns=rr.Scalars.columns(scalars=rows.ravel()).partition(
+                                 [3] * len(rows)))
+            rec.log(paths.robot_imu(rid, what), rr.SeriesLines(names=["x", "y", "z"]),
+                    static=True)
+
+
+def _log_frames(rr: Any, rec: Any, entity: str, frames: list[KeptFrame]) -> None:
+    k = frames[0].intrinsics
+    rec.log(entity, rr.Pinhole(focal_length=k.fx, width=k.width, height=k.height,
+                               camera_xyz=rr.ViewCoordinates.RDF, image_plane_distance=0.5),
+            static=True)
+    rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE,
+                                                    duration=[f.time for f in frames])],
+                     columns=rr.Transform3D.columns(translation=[f.eye for f in frames],
+                                                    mat3x3=[f.rotation for f in frames]))
+    for frame in frames:
+        rec.set_time(paths.TIMELINE, duration=frame.time)
+        rec.log(f"{entity}/rgb", rr.Image(frame.rgb))
+        rec.log(f"{entity}/depth", rr.DepthImage(frame.depth, meter=1.0))
+        rec.log(f"{entity}/segmentation", rr.SegmentationImage(frame.segmentation))
+
+
+def log_detections(rr: Any, rec: Any, records: list[Record]) -> None:
+    """Each detection at its time: the estimate (labelled with its error) and an arrow from
+    the robot's camera to it."""
+    hits = [r for r in records if r["kind"] == "detection"]
+    if not hits:
+        return
+    for hit in hits:
+        rec.set_time(paths.TIMELINE, duration=hit["t"])
+        origin = np.asarray(hit["robot_position"], dtype=float)
+        estimate = np.asarray(hit["estimate"], dtype=float)
+        rec.log(paths.MISSION_DETECTIONS, rr.Points3D(
+            [estimate], radii=0.25, colors=[(255, 40, 40)],
+            labels=[f"{hit['robot']} saw the target (error {hit['error']:.2f} m)"]),
+            rr.Arrows3D(origins=[origin], vectors=[estimate - origin], colors=[(255, 40, 40)]))
