@@ -43,6 +43,11 @@ def _parser() -> argparse.ArgumentParser:
                      help="override the mission's fidelity")
     run.add_argument("--no-recording", action="store_true", help="skip the Rerun recording")
     run.add_argument("--quiet", action="store_true", help="no progress bar or summary table")
+    run.add_argument("--view", action="store_true", help="also stream the recording to a "
+                     "Rerun viewer it spawns")
+    replay = sub.add_parser("replay", help="open a run's recording in the Rerun viewer")
+    replay.add_argument("recording", help="a recording.rrd")
+    replay.add_argument("--web", action="store_true", help="serve the web viewer instead")
     val = sub.add_parser("validate", help="check a mission file without running it")
     val.add_argument("mission", help="mission YAML file")
     world = sub.add_parser("world", help="look at worlds")
@@ -79,6 +84,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     except InputError as exc:
         print(f"error: {exc.one_line()}", file=sys.stderr)
         return EXIT_BAD_INPUT
+
+
+@command("replay")
+def _replay(args: argparse.Namespace) -> int:
+    from astralis_des.sinks.viewer import open_viewer
+
+    return open_viewer(Path(args.recording), web=args.web)
 
 
 @command("validate")
@@ -142,7 +154,8 @@ def _run(args: argparse.Namespace) -> int:
     try:
         result = _with_progress(console, mission.spec.time_limit,
                                 lambda progress: Simulation(mission, out_dir=out,
-                                                            progress=progress).run())
+                                                            progress=progress,
+                                                            view=args.view).run())
     except KeyboardInterrupt:
         console.print(f"[yellow]interrupted[/]; what was recorded is in {out}/")
         return EXIT_INTERRUPTED

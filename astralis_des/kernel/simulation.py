@@ -41,8 +41,9 @@ class Simulation:
     writes ``events.jsonl``, ``summary.json`` and ``recording.rrd`` there."""
 
     def __init__(self, mission: Mission, *, out_dir: str | Path | None = None,
-                 progress: Progress | None = None) -> None:
+                 progress: Progress | None = None, view: bool = False) -> None:
         spec = mission.spec
+        self.view = view  # also stream the recording to a spawned Rerun viewer
         self._held: list[tuple[str, str, str]] = []
         self._end: simpy.Event | None = None
         self.mission = mission
@@ -251,8 +252,8 @@ class Simulation:
             outcome = "found"
         elif self._timeline is not None and self._timeline.triggered:
             outcome = str(self._timeline.value)
-        elif self._limit is not None and self._limit.triggered:
-            outcome = "time_limit"
+        elif self._limit is not None and self._limit.processed:  # a Timeout is "triggered"
+            outcome = "time_limit"                                  # as soon as it exists
         else:
             outcome = "interrupted"
         for robot in self.robots.values():

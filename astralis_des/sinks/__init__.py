@@ -42,11 +42,11 @@ class Outputs:
 
 
 class JsonlWriter:
-    """``events.jsonl``: one event a line, written as it happens, so an interrupted run keeps
-    every complete line."""
+    """``events.jsonl``: one event a line, written as it happens (line-buffered), so an
+    interrupted or killed run keeps every complete line and a reader can follow it."""
 
     def __init__(self, path: Path) -> None:
-        self._file = path.open("w", encoding="utf-8")
+        self._file = path.open("w", encoding="utf-8", buffering=1)
 
     def on_event(self, record: Record) -> None:
         self._file.write(dumps(record) + "\n")
@@ -91,7 +91,7 @@ def open_sinks(sim: Simulation, out_dir: Path | None) -> Outputs:
         if cfg.recording:
             from astralis_des.sinks.recording import RerunRecorder
 
-            outputs.append(RerunRecorder(sim, out_dir / "recording.rrd"))
+            outputs.append(RerunRecorder(sim, out_dir / "recording.rrd", view=sim.view))
     sinks = Outputs(outputs, time.perf_counter() - t0)
     sim.log.sinks.append(sinks.on_event)
     return sinks

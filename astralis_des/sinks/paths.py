@@ -47,3 +47,15 @@ def robot_imu(robot_id: str, what: str) -> str:
 
 
 MISSION_DETECTIONS = "mission/detections"
+
+
+def robot_state(robot_id: str) -> str:
+    """The robot's task lane (a state timeline)."""
+    return f"robots/{robot_id}/state"
+
+
+MISSION_METRICS = "mission/metrics"
+
+
+def mission_metric(name: str) -> str:
+    return f"{MISSION_METRICS}/{name}"

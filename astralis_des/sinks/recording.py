@@ -3,7 +3,7 @@ trails, each robot's task and the events as text, on one ``sim_time`` timeline."
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Generator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -11,6 +11,8 @@ import numpy as np
 
 from astralis_des.kernel.events import LEVELS, Record
 from astralis_des.sinks import paths
+from astralis_des.sinks.blueprint import blueprint
+from astralis_des.sinks.replay import log_lanes, log_metrics, log_rounds, metrics, task_lanes
 from astralis_des.sinks.sensor_log import log_detections, log_sensors
 from astralis_des.world.clutter import Placed
 from astralis_des.world.model import World
@@ -41,21 +43,42 @@ class _TextColumn:
         self.levels.append(level)
 
 
+LIVE_PERIOD = 2.0  # s of simulated time between sends to a live viewer
+
+
 class RerunRecorder:
     """Writes ``recording.rrd``: the world at once, then events, task states and poses in
     columns when the run closes (also when it is interrupted), since one ``log`` call costs
     about as much as simulating a whole task."""
 
-    def __init__(self, sim: Simulation, path: Path) -> None:
+    def __init__(self, sim: Simulation, path: Path, view: bool = False) -> None:
         import rerun as rr
 
         self.rr = rr
         self.sim = sim
         spec = sim.mission.spec
         self.rec = rr.RecordingStream("astralis_des", recording_id=f"{spec.name}-{spec.seed}")
+        self.rec.set_log_time_enabled(False)  # one timeline: simulated time
         self.rec.save(path)
         self._texts: dict[str, _TextColumn] = {}
+        self._sent: dict[str, int] = {}  # entity -> rows of its column already sent
+        if view:
+            self.connect_viewer(path)
+            sim.env.process(self._stream())
         self._log_world()
+
+    def connect_viewer(self, path: Path) -> None:
+        """Spawn a Rerun viewer and send to it as well as to the file."""
+        rr = self.rr
+        self.rec.spawn(connect=False)
+        self.rec.set_sinks(rr.FileSink(str(path)), rr.GrpcSink())
+
+    def _stream(self) -> Generator[Any, Any, None]:
+        """With a live viewer: send what the columns gained every ``LIVE_PERIOD`` simulated
+        seconds, rather than all of it when the run closes."""
+        while True:
+            yield self.sim.env.timeout(LIVE_PERIOD)
+            self._send_new()
 
     def _log_world(self) -> None:
         rr, rec, sim = self.rr, self.rec, self.sim
@@ -114,23 +137,56 @@ class RerunRecorder:
         if perception is not None:
             log_sensors(rr, rec, perception)
         log_detections(rr, rec, self.sim.log.records)
-        for entity, column in self._texts.items():
-            rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE,
-                                                            duration=column.times)],
-                             columns=rr.TextLog.columns(text=column.texts, level=column.levels))
+        self._send_new()
         for rid, robot in self.sim.robots.items():
-            times = np.array(robot.trail_t, dtype=float)
             pts = np.array(robot.trail_p, dtype=float)
             color = ROBOT_COLORS[robot.kind]
-            rec.send_columns(paths.robot_pose(rid),
-                             indexes=[rr.TimeColumn(paths.TIMELINE, duration=times)],
-                             columns=rr.Points3D.columns(positions=pts))
             rec.log(paths.robot_pose(rid), rr.Points3D.from_fields(
                 radii=0.35, colors=[color], labels=[rid]), static=True)
             rec.log(paths.robot_trail(rid), rr.LineStrips3D([pts], colors=[color], radii=0.05),
                     static=True)
+        self._log_replay(result, perception)
         rec.flush()
         rec.disconnect()
+
+    def _send_new(self) -> None:
+        """Send the rows of the text and pose columns not sent yet."""
+        rr, rec = self.rr, self.rec
+        for entity, column in self._texts.items():
+            start = self._sent.get(entity, 0)
+            if start < len(column.times):
+                rec.send_columns(entity, indexes=[rr.TimeColumn(
+                    paths.TIMELINE, duration=column.times[start:])],
+                    columns=rr.TextLog.columns(text=column.texts[start:],
+                                               level=column.levels[start:]))
+                self._sent[entity] = len(column.times)
+        for rid, robot in self.sim.robots.items():
+            entity = paths.robot_pose(rid)
+            start = self._sent.get(entity, 0)
+            if start < len(robot.trail_t):
+                rec.send_columns(entity, indexes=[rr.TimeColumn(
+                    paths.TIMELINE, duration=np.array(robot.trail_t[start:], dtype=float))],
+                    columns=rr.Points3D.columns(
+                        positions=np.array(robot.trail_p[start:], dtype=float)))
+                self._sent[entity] = len(robot.trail_t)
+
+    def _log_replay(self, result: RunResult, perception: Any) -> None:
+        """Task lanes, assignment graphs, metrics, and the layout that shows them."""
+        rr, rec, sim = self.rr, self.rec, self.sim
+        kinds = {rid: robot.kind for rid, robot in sim.robots.items()}
+        records = sim.log.records
+        log_lanes(rr, rec, task_lanes(records, list(sim.robots)))
+        log_rounds(rr, rec, sim.rounds, kinds)
+        cfg = sim.mission.spec.assignment
+        log_metrics(rr, rec, metrics(records, sim.rounds, kinds, cfg.high_risk,
+                                     cfg.high_messiness))
+        framed = perception is not None and any(
+            f.robot == result.found_by for f in perception.frames)
+        rooms = [sim.world.rooms[r].box for r in sim.mission.searched_rooms()]
+        focus = ((min(b.lo[0] for b in rooms), min(b.lo[1] for b in rooms), 0.0),
+                 (max(b.hi[0] for b in rooms), max(b.hi[1] for b in rooms),
+                  max(b.hi[2] for b in rooms)))
+        rec.send_blueprint(blueprint(result.found_by, framed, focus))
 
 
 def describe(record: Record) -> str:

@@ -1,0 +1,165 @@
+"""What a replay explains beyond poses: each robot's task lane, each assignment round's
+bipartite graph, and the mission's metrics as time series. All is derived from the event log
+and the rounds when the run closes, and sent in columns."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from astralis_des.kernel.events import Record
+from astralis_des.sinks import paths
+
+IDLE, MOVING, FAILED, FAULTED = "idle", "moving", "failed", "faulted"
+LANE_COLORS = {IDLE: (150, 150, 150), MOVING: (70, 150, 255), FAILED: (230, 60, 60),
+               FAULTED: (130, 0, 0)}
+SEARCH_COLOR = (60, 200, 90)
+KIND_COLORS = {"uav": (30, 144, 255), "ugv": (255, 165, 0), "human": (220, 20, 60)}
+
+
+@dataclass
+class Lane:
+    times: list[float] = field(default_factory=lambda: [0.0])
+    states: list[str] = field(default_factory=lambda: [IDLE])
+
+    def add(self, t: float, state: str) -> None:
+        self.times.append(t)
+        self.states.append(state)
+
+
+def task_lanes(records: Sequence[Record], robots: Sequence[str]) -> dict[str, Lane]:
+    """Each robot's state over time: idle at the start, then one change per task start
+    (``moving``, or ``searching: <action>``) and end (``idle``, or ``failed``), and per fault
+    (``faulted``) and recovery (``idle``)."""
+    lanes = {rid: Lane() for rid in robots}
+    for record in records:
+        lane = lanes.get(record.get("robot", ""))
+        if lane is None:
+            continue
+        state = _state(record)
+        if state is not None:
+            lane.add(record["t"], state)
+    return lanes
+
+
+def _state(record: Record) -> str | None:
+    kind = record["kind"]
+    if kind == "task_started":
+        return MOVING if record["action"] == "move" else f"searching: {record['action']}"
+    if kind == "task_finished":
+        return FAILED if record["status"] == "failed" else IDLE
+    return {"fault": FAULTED, "recover": IDLE}.get(kind)
+
+
+def log_lanes(rr: Any, rec: Any, lanes: Mapping[str, Lane]) -> None:
+    for rid, lane in lanes.items():
+        entity = paths.robot_state(rid)
+        values = sorted(set(lane.states))
+        rec.log(entity, rr.StateConfiguration(
+            values=values, labels=values,
+            colors=[LANE_COLORS.get(v, SEARCH_COLOR) for v in values]), static=True)
+        rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE, duration=lane.times)],
+                         columns=rr.StateChange.columns(state=lane.states))
+
+
+def log_rounds(rr: Any, rec: Any, rounds: Sequence[Mapping[str, Any]],
+               kinds: Mapping[str, str]) -> None:
+    """Each round's bipartite graph at its time: agents on the left, rooms on the right, and
+    between them one small node per edge labelled with Eq. 1's cost; the chosen pairs' cost
+    nodes are large and green, the others small and grey."""
+    for record in rounds:
+        agents, rooms = list(record["agents"]), list(record["rooms"])
+        ids, positions, labels, colors, radii = [], [], [], [], []
+        edges: list[tuple[str, str]] = []
+        for i, agent in enumerate(agents):
+            ids.append(agent)
+            positions.append((0.0, 100.0 * i))
+            labels.append(f"{agent} ({kinds.get(agent, '?')})")
+            colors.append(KIND_COLORS.get(kinds.get(agent, ""), (200, 200, 200)))
+            radii.append(12.0)
+        for j, room in enumerate(rooms):
+            ids.append(room)
+            positions.append((600.0, 100.0 * j + 50.0 * (len(agents) - len(rooms))))
+            labels.append(f"{room} risk {record['risk'][j]:.2f} mess "
+                          f"{record['messiness'][j]:.2f}")
+            colors.append((int(255 * record["risk"][j]), 60, int(255 * record["messiness"][j])))
+            radii.append(12.0)
+        chosen = {(m["agent"], m["room"]) for m in record["matching"]}
+        for i, agent in enumerate(agents):
+            for j, room in enumerate(rooms):
+                cost = record["costs"][i][j]
+                if cost is None:
+                    continue
+                node = f"{agent}->{room}"
+                share = 0.3 + 0.4 * (j + 1) / (len(rooms) + 1)
+                a, b = np.array(positions[i]), np.array(positions[len(agents) + j])
+                ids.append(node)
+                positions.append(tuple(a + share * (b - a)))
+                picked = (agent, room) in chosen
+                labels.append(f"{cost:.2f}" + (" chosen" if picked else ""))
+                colors.append((40, 220, 90) if picked else (110, 110, 110))
+                radii.append(8.0 if picked else 3.0)
+                edges += [(agent, node), (node, room)]
+        rec.set_time(paths.TIMELINE, duration=record["t"])
+        rec.log(paths.MISSION_ROUNDS, rr.GraphNodes(ids, positions=positions, labels=labels,
+                                                    colors=colors, radii=radii),
+                rr.GraphEdges(edges, graph_type="directed"))
+
+
+Series = dict[str, tuple[list[float], list[float]]]
+
+
+def metrics(records: Sequence[Record], rounds: Sequence[Mapping[str, Any]],
+            kinds: Mapping[str, str], high_risk: float, high_messiness: float) -> Series:
+    """Time series of the mission: rooms searched, each search's coverage, each robot's
+    distance, the human's seconds in high-risk rooms and the UGV's in high-messiness ones."""
+    series: Series = {}
+
+    def add(name: str, t: float, value: float) -> None:
+        times, values = series.setdefault(name, ([], []))
+        times.append(t)
+        values.append(value)
+
+    latest: dict[str, tuple[float, float]] = {}  # room -> risk, messiness at its last round
+    by_time = sorted(rounds, key=lambda r: r["t"])
+    started: dict[int, float] = {}
+    searched, distance = 0, dict.fromkeys(kinds, 0.0)
+    exposure = {"human_in_high_risk_s": 0.0, "ugv_in_high_messiness_s": 0.0}
+    for record in records:
+        t, kind = record["t"], record["kind"]
+        while by_time and by_time[0]["t"] <= t:
+            r = by_time.pop(0)
+            latest.update({room: (r["risk"][j], r["messiness"][j])
+                           for j, room in enumerate(r["rooms"])})
+        if kind == "task_started":
+            started[record["task"]] = t
+        if kind != "task_finished":
+            continue
+        robot = record["robot"]
+        distance[robot] = distance.get(robot, 0.0) + float(record.get("distance") or 0.0)
+        add(f"distance/{robot}", t, distance[robot])
+        if "coverage" in record and record["status"] == "succeeded":
+            searched += 1
+            add("rooms_searched", t, searched)
+            add("coverage", t, float(record["coverage"]))
+        risk, mess = latest.get(record.get("room") or "", (0.0, 0.0))
+        spent = t - started.get(record["task"], t)
+        if kinds.get(robot) == "human" and risk >= high_risk:
+            exposure["human_in_high_risk_s"] += spent
+            add("human_in_high_risk_s", t, exposure["human_in_high_risk_s"])
+        if kinds.get(robot) == "ugv" and mess >= high_messiness:
+            exposure["ugv_in_high_messiness_s"] += spent
+            add("ugv_in_high_messiness_s", t, exposure["ugv_in_high_messiness_s"])
+    return series
+
+
+def log_metrics(rr: Any, rec: Any, series: Series) -> None:
+    for name, (times, values) in series.items():
+        entity = paths.mission_metric(name)
+        rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE, duration=times)],
+                         columns=rr.Scalars.columns(scalars=values))
+        style = rr.SeriesPoints if name == "coverage" else rr.SeriesLines
+        rec.log(entity, style(names=[name.replace("_", " ")]), static=True)

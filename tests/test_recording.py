@@ -1,0 +1,194 @@
+"""The replay: a recording that loads, with the entity tree, one timeline, task lanes,
+assignment graphs, metrics and a layout; the replay command; an interrupted run."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import pytest
+
+from astralis_des import RunResult, Simulation, load_mission
+from astralis_des.cli import main
+from astralis_des.sinks import recording as recording_module
+
+ROOT = Path(__file__).resolve().parents[1]
+RERUN = str(Path(sys.executable).with_name("rerun"))
+LAYOUT = ("/view", "/container", "/viewport", "/time_panel", "/blueprint_panel",
+          "/selection_panel", "/top_panel")  # the blueprint's own entities
+CHUNK = re.compile(r"^Chunk\(\S+\) with (\d+) rows \([^)]*\) - (\S+) - data columns: \[(.*)\]")
+
+
+def chunks(path: Path) -> dict[str, dict[str, int]]:
+    """Rows per entity and archetype in the recording's data (not its layout), from
+    ``rerun rrd print``."""
+    out = subprocess.run([RERUN, "rrd", "print", "-v", str(path)], capture_output=True,
+                         text=True, check=True).stdout
+    rows: dict[str, dict[str, int]] = defaultdict(lambda: defaultdict(int))
+    for line in out.splitlines():
+        match = CHUNK.match(line)
+        if match and not match[2].startswith(LAYOUT):
+            n, entity, columns = int(match[1]), match[2], match[3]
+            for archetype in {c.split("@")[1].split(":")[0] for c in columns.split()}:
+                rows[entity][archetype] += n
+    return rows
+
+
+def verify(path: Path) -> None:
+    done = subprocess.run([RERUN, "rrd", "verify", str(path)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+
+
+@pytest.fixture(scope="module")
+def faults_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[RunResult, Path]:
+    out = tmp_path_factory.mktemp("faults")
+    result = Simulation(load_mission(ROOT / "missions" / "faults.yaml"), out_dir=out).run()
+    return result, out / "recording.rrd"
+
+
+def test_the_recording_loads_with_its_entity_tree(faults_run: tuple[RunResult, Path]) -> None:
+    """rerun rrd verify accepts it; world, robots and mission entities are all there."""
+    result, rrd = faults_run
+    verify(rrd)
+    rows = chunks(rrd)
+    for entity in ("/world/solids", "/world/rooms", "/world/target", "/mission/events",
+                   "/mission/assignment", "/mission/metrics/rooms_searched"):
+        assert entity in rows, entity
+    for rid in result.robots:
+        for leaf in ("pose", "trail", "state", "task"):
+            assert f"/robots/{rid}/{leaf}" in rows, (rid, leaf)
+
+
+def test_one_state_change_per_task_start_and_end(faults_run: tuple[RunResult, Path]) -> None:
+    """Each lane starts idle, then changes at every task start and end, fault and recovery."""
+    result, rrd = faults_run
+    rows = chunks(rrd)
+    for rid in result.robots:
+        changes = sum(1 for e in result.events if e.get("robot") == rid and e["kind"] in
+                      ("task_started", "task_finished", "fault", "recover"))
+        assert rows[f"/robots/{rid}/state"]["StateChange"] == 1 + changes, rid
+    assert any(e["kind"] == "fault" for e in result.events)
+
+
+def test_one_graph_per_assignment_round(faults_run: tuple[RunResult, Path]) -> None:
+    """The assignment entity holds one graph (nodes and edges) per round."""
+    result, rrd = faults_run
+    rows = chunks(rrd)["/mission/assignment"]
+    assert rows["GraphNodes"] == rows["GraphEdges"] == len(result.rounds) >= 2
+
+
+def test_metrics_count_the_rooms_searched(faults_run: tuple[RunResult, Path]) -> None:
+    """rooms_searched has one point per search that succeeded; every robot that moved has a
+    distance series."""
+    result, rrd = faults_run
+    rows = chunks(rrd)
+    searches = [e for e in result.events if e["kind"] == "task_finished"
+                and e["status"] == "succeeded" and "coverage" in e]
+    assert rows["/mission/metrics/rooms_searched"]["Scalars"] == len(searches) > 0
+    moved = {rid for rid, s in result.robots.items() if s.tasks_succeeded + s.tasks_failed}
+    assert {e.split("/")[-1] for e in rows if e.startswith("/mission/metrics/distance/")} == moved
+
+
+def test_everything_is_on_the_sim_time_timeline(faults_run: tuple[RunResult, Path]) -> None:
+    """The data has one timeline, sim_time (no wall-clock log_time)."""
+    _, rrd = faults_run
+    out = subprocess.run([RERUN, "rrd", "print", "-vv", str(rrd)], capture_output=True,
+                         text=True, check=True).stdout
+    timelines: set[str] = set()
+    for block in out.split("Chunk(")[1:]:
+        entity = block.split(" - ")[1] if " - " in block else ""
+        if not entity.startswith(LAYOUT):
+            timelines.update(re.findall(r"index_name: (\w+)", block))
+    assert timelines == {"sim_time"}
+
+
+def test_a_physics_recording_has_the_finders_frames(tmp_path: Path) -> None:
+    """In physics the robot that found the target has camera frames (RGB, depth,
+    segmentation) under a pinhole, and the detection is drawn; the layout shows its camera."""
+    mission = load_mission(ROOT / "missions" / "fig7.yaml").with_changes(fidelity="physics")
+    result = Simulation(mission, out_dir=tmp_path).run()
+    assert result.found_by is not None
+    rows = chunks(tmp_path / "recording.rrd")
+    camera = f"/robots/{result.found_by}/camera"
+    assert rows[camera]["Pinhole"] == 1 and rows[camera]["Transform3D"] >= 1
+    for image, archetype in (("rgb", "Image"), ("depth", "DepthImage"),
+                             ("segmentation", "SegmentationImage")):
+        assert rows[f"{camera}/{image}"][archetype] == rows[camera]["Transform3D"]
+    assert rows["/mission/detections"]["Points3D"] == 1
+    out = subprocess.run([RERUN, "rrd", "print", "-vvv", str(tmp_path / "recording.rrd")],
+                         capture_output=True, text=True, check=True).stdout
+    assert f"{result.found_by}'s camera (found the target)" in out
+
+
+def test_replay_refuses_what_is_not_a_recording(tmp_path: Path,
+                                                capsys: pytest.CaptureFixture[str]) -> None:
+    """A missing file, an empty one and a text file: one line each, exit 2."""
+    text = tmp_path / "notes.rrd"
+    text.write_text("hello\n", encoding="utf-8")
+    empty = tmp_path / "empty.rrd"
+    empty.write_bytes(b"")
+    for path, says in ((tmp_path / "missing.rrd", "no such recording"),
+                       (empty, "empty"), (text, "not a Rerun recording")):
+        assert main(["replay", str(path)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and str(path) in err and says in err, err
+
+
+def test_replay_opens_the_viewer_on_a_recording(faults_run: tuple[RunResult, Path],
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    """On a recording, replay runs the rerun viewer on it and returns its exit code."""
+    _, rrd = faults_run
+    calls: list[list[str]] = []
+    monkeypatch.setattr(subprocess, "call", lambda cmd: calls.append(cmd) or 0)
+    assert main(["replay", str(rrd)]) == 0
+    assert calls and calls[0][0].endswith("rerun") and calls[0][-1] == str(rrd)
+
+
+def test_view_streams_to_a_viewer_as_the_run_goes(tmp_path: Path,
+                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    """--view connects a viewer and sends the event log in pieces during the run, and the
+    file still gets all of it."""
+    connected: list[Path] = []
+    monkeypatch.setattr(recording_module.RerunRecorder, "connect_viewer",
+                        lambda self, path: connected.append(path))
+    assert main(["run", str(ROOT / "missions" / "fig7.yaml"), "--out", str(tmp_path),
+                 "--quiet", "--view"]) == 0
+    assert connected == [tmp_path / "recording.rrd"]
+    out = subprocess.run([RERUN, "rrd", "print", str(tmp_path / "recording.rrd")],
+                         capture_output=True, text=True, check=True).stdout
+    pieces = [int(m[1]) for m in map(CHUNK.match, out.splitlines())
+              if m and m[2] == "/mission/events"]
+    events = (tmp_path / "events.jsonl").read_text(encoding="utf-8").splitlines()
+    assert len(pieces) > 1 and sum(pieces) == len(events)
+
+
+def test_ctrl_c_leaves_a_recording_and_an_event_log_that_load(tmp_path: Path) -> None:
+    """SIGINT in the middle of a physics run: exit 130, the recording verifies, every line of
+    the event log is JSON, and the last says the mission was interrupted."""
+    out = tmp_path / "run"
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    proc = subprocess.Popen([sys.executable, "-m", "astralis_des.cli", "run",
+                             str(ROOT / "missions" / "urban_search.yaml"), "--fidelity",
+                             "physics", "--out", str(out), "--quiet"], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    events = out / "events.jsonl"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and proc.poll() is None:
+        if events.exists() and events.read_text(encoding="utf-8").count("task_started") >= 3:
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, "the run ended before it could be interrupted"
+    proc.send_signal(signal.SIGINT)
+    assert proc.wait(timeout=60) == 130
+    verify(out / "recording.rrd")
+    records = [json.loads(line) for line in events.read_text(encoding="utf-8").splitlines()]
+    assert records[0]["kind"] == "mission_start"
+    assert records[-1] == {**records[-1], "kind": "mission_end", "outcome": "interrupted"}
+    assert "/robots/uav1/state" in chunks(out / "recording.rrd")
