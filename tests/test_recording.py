@@ -61,8 +61,9 @@ def test_the_recording_loads_with_its_entity_tree(faults_run: tuple[RunResult, P
     for entity in ("/world/solids", "/world/rooms", "/world/target", "/mission/events",
                    "/mission/assignment", "/mission/metrics/rooms_searched"):
         assert entity in rows, entity
-    for rid in result.robots:
-        for leaf in ("pose", "trail", "state", "task"):
+    for rid, stats in result.robots.items():
+        leaves = ("pose", "trail", "state", "task") + (("plan",) if stats.distance else ())
+        for leaf in leaves:
             assert f"/robots/{rid}/{leaf}" in rows, (rid, leaf)
 
 

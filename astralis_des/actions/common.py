@@ -74,6 +74,7 @@ def route(ctx: Context, robot: Robot,
 def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> StepGen:
     """Follow ``points``; when sensing, report the target the moment it comes into view."""
     before = robot.distance
+    robot.plans.append((ctx.env.now, np.asarray(points, dtype=float)))
     motion = Motion(points, robot.speed, accel=robot.accel, turn_rate=robot.turn_rate,
                     heading=robot.heading)
     done = ctx.cosim.execute(robot, motion)

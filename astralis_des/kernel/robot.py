@@ -120,6 +120,7 @@ class Robot:
     busy_time: float = 0.0
     trail_t: list[float] = field(default_factory=list)
     trail_p: list[FloatArray] = field(default_factory=list)
+    plans: list[tuple[float, FloatArray]] = field(default_factory=list)  # (start, path) a leg
 
     def position(self, now: float) -> FloatArray:
         return self.motion.at(now) if self.motion is not None else self.pose

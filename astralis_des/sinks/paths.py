@@ -26,6 +26,11 @@ def robot_trail(robot_id: str) -> str:
     return f"robots/{robot_id}/trail"
 
 
+def robot_plan(robot_id: str) -> str:
+    """The path the robot's current leg follows (as planned)."""
+    return f"robots/{robot_id}/plan"
+
+
 def robot_task(robot_id: str) -> str:
     return f"robots/{robot_id}/task"
 

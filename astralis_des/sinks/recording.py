@@ -145,6 +145,12 @@ class RerunRecorder:
                 radii=0.35, colors=[color], labels=[rid]), static=True)
             rec.log(paths.robot_trail(rid), rr.LineStrips3D([pts], colors=[color], radii=0.05),
                     static=True)
+            if robot.plans:  # each leg's planned path, from when it was set out on
+                rec.send_columns(paths.robot_plan(rid), indexes=[rr.TimeColumn(
+                    paths.TIMELINE, duration=[t for t, _ in robot.plans])],
+                    columns=rr.LineStrips3D.columns(strips=[p for _, p in robot.plans]))
+                rec.log(paths.robot_plan(rid), rr.LineStrips3D.from_fields(
+                    colors=[(*color[:3], 140)], radii=0.03), static=True)
         self._log_replay(result, perception)
         rec.flush()
         rec.disconnect()
