@@ -119,7 +119,7 @@ def test_a_physics_recording_has_the_finders_frames(tmp_path: Path) -> None:
     rows = chunks(tmp_path / "recording.rrd")
     camera = f"/robots/{result.found_by}/camera"
     assert rows[camera]["Pinhole"] == 1 and rows[camera]["Transform3D"] >= 1
-    for image, archetype in (("rgb", "Image"), ("depth", "DepthImage"),
+    for image, archetype in (("rgb", "EncodedImage"), ("depth", "DepthImage"),
                              ("segmentation", "SegmentationImage")):
         assert rows[f"{camera}/{image}"][archetype] == rows[camera]["Transform3D"]
     assert rows["/mission/detections"]["Points3D"] == 1

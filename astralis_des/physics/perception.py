@@ -69,7 +69,7 @@ class KeptFrame:
     robot: str
     time: float
     rgb: NDArray[np.uint8]
-    depth: NDArray[np.float32]  # metres; 0 where nothing was rendered
+    depth: NDArray[np.uint16]  # millimetres (to 65 m); 0 where nothing was rendered
     segmentation: NDArray[np.uint16]  # body id + 1; 0 where nothing was rendered
     eye: FloatArray
     rotation: FloatArray  # world_from_camera
@@ -214,8 +214,9 @@ class Perception:
     def _keep(self, robot_id: str, frame: Frame, detection: bool, step: int = 1) -> None:
         k = frame.intrinsics
         small = Intrinsics(k.width // step, k.height // step, k.fov_deg, k.near, k.far)
-        depth = frame.depth[::step, ::step].astype(np.float32)
-        depth[~np.isfinite(depth)] = 0.0
+        metres = frame.depth[::step, ::step]
+        depth = np.where(np.isfinite(metres), np.clip(metres * 1000.0, 0, 65535), 0.0
+                         ).round().astype(np.uint16)
         segmentation = (frame.segmentation[::step, ::step] + 1).astype(np.uint16)
         self.frames.append(KeptFrame(robot_id, frame.time, frame.rgb[::step, ::step].copy(),
                                      depth, segmentation, frame.pose[0], frame.pose[1], small,

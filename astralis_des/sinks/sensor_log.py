@@ -1,6 +1,7 @@
-"""What the sensors saw, in the recording: kept camera frames (RGB, depth, segmentation) under
-a pinhole that moves with the camera, lidar returns, IMU readings, and the detections (the
-estimate, and an arrow from the robot to it). Poses, points and readings go in columns."""
+"""What the sensors saw, in the recording: kept camera frames (RGB as JPEG, depth in
+millimetres, segmentation) under a pinhole that moves with the camera, lidar returns, IMU
+readings, and the detections (the estimate, and an arrow from the robot to it). Poses, points
+and readings go in columns."""
 
 from __future__ import annotations
 
@@ -59,8 +60,8 @@ def _log_frames(rr: Any, rec: Any, entity: str, frames: list[KeptFrame]) -> None
                                                     mat3x3=[f.rotation for f in frames]))
     for frame in frames:
         rec.set_time(paths.TIMELINE, duration=frame.time)
-        rec.log(f"{entity}/rgb", rr.Image(frame.rgb))
-        rec.log(f"{entity}/depth", rr.DepthImage(frame.depth, meter=1.0))
+        rec.log(f"{entity}/rgb", rr.Image(frame.rgb).compress(jpeg_quality=85))
+        rec.log(f"{entity}/depth", rr.DepthImage(frame.depth, meter=1000.0))
         rec.log(f"{entity}/segmentation", rr.SegmentationImage(frame.segmentation))
 
 
