@@ -61,10 +61,35 @@ def _parser() -> argparse.ArgumentParser:
     show.add_argument("--seed", type=int, default=0)
     show.add_argument("--catalogue", help="clutter catalogue file (default: the packaged one)")
     show.add_argument("-o", "--output", help="recording to write (default out/world_NAME.rrd)")
+    _add_import_parser(world_sub)
+    study = sub.add_parser("study", help="run a scheduling study: scenarios x variants, "
+                           "a table, plots and a report in one folder")
+    study.add_argument("study", help="study YAML file")
+    study.add_argument("--workers", type=_positive, help="processes (default: the CPUs)")
+    study.add_argument("--backend", default="local",
+                       help="local (a process pool, the default) or ray")
+    study.add_argument("--address", help="ray: the address of an existing cluster "
+                       "(default: a local instance)")
+    study.add_argument("--out", help="output folder (default out/<study name>)")
+    study.add_argument("--scenarios", type=int, help="override the study's scenario count")
+    study.add_argument("--recordings", action="store_true",
+                       help="write each mission's outputs under the folder's scenarios/")
+    study.add_argument("--replay", type=int, metavar="N",
+                       help="run scenario N alone, here, as the study does; show its rows, "
+                       "or its traceback if it fails")
+    study.add_argument("--variant", help="with --replay: only this variant")
+    study.add_argument("--quiet", action="store_true", help="no progress bar or report")
     schema = sub.add_parser("schema", help="print the JSON Schema of mission or world files")
     schema.add_argument("--world", action="store_true", help="the world file's schema")
     schema.add_argument("-o", "--output", help="write to this file instead of stdout")
     return parser
+
+
+def _positive(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1 (got {value})")
+    return value
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -103,8 +128,91 @@ def _validate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_import_parser(world_sub: Any) -> None:
+    imp = world_sub.add_parser(
+        "import", help="make a world (a digital twin) of a point cloud or a mesh",
+        description="Point clouds: LAS, LAZ, PLY, PCD, XYZ/CSV. Meshes: OBJ, glTF/GLB, STL "
+                    "(and PLY with faces). Writes the world file and, beside it, its blocks, "
+                    "mesh and cloud.")
+    imp.add_argument("file", help="the cloud or mesh to import")
+    imp.add_argument("-o", "--output", required=True, help="world file to write "
+                     "(worlds/NAME.yaml)")
+    imp.add_argument("--units", default="auto", help="auto (the file's CRS, else metres), m "
+                     "or ft")
+    imp.add_argument("--voxel", type=float, default=0.2, help="m, of the blocks and the "
+                     "planner's map (default 0.2)")
+    imp.add_argument("--ground", default="auto", help="auto (the classification, else grid), "
+                     "classification, grid or ransac")
+    imp.add_argument("--fill", default="auto", help="columns (aerial: solid down to the "
+                     "ground) or none; auto: columns for LAS/LAZ")
+    imp.add_argument("--up", default="auto", help="a mesh's up axis: auto, y or z")
+    imp.add_argument("--scale", type=float, default=1.0, help="times the units (default 1)")
+    imp.add_argument("--collision", default="auto", help="physics: boxes (clouds), concave "
+                     "(meshes, the default) or convex (V-HACD parts)")
+    imp.add_argument("--areas", type=int, default=4, help="search areas to place (default 4)")
+    imp.add_argument("--area-size", type=float, default=20.0, help="m, their side (default 20)")
+    imp.add_argument("--margin", type=float, default=2.0, help="m of site around the geometry")
+    imp.add_argument("--cloud-points", type=int, default=50_000,
+                     help="points kept for the replay (default 50,000)")
+    imp.add_argument("--seed", type=int, default=0, help="of RANSAC and downsampling")
+    imp.add_argument("--name", help="the world's name (default: the output file's stem)")
+
+
+WORLD_COMMANDS: dict[str, Command] = {}
+
+
 @command("world")
 def _world(args: argparse.Namespace) -> int:
+    return WORLD_COMMANDS[args.world_command](args)
+
+
+def world_command(name: str) -> Callable[[Command], Command]:
+    def add(fn: Command) -> Command:
+        WORLD_COMMANDS[name] = fn
+        return fn
+
+    return add
+
+
+@world_command("import")
+def _world_import(args: argparse.Namespace) -> int:
+    from rich.console import Console
+
+    from astralis_des.importers import ImportOptions, import_world
+
+    options = ImportOptions(
+        units=args.units, voxel=args.voxel, ground=args.ground, fill=args.fill, up=args.up,
+        scale=args.scale, collision=args.collision, areas=args.areas,
+        area_size=args.area_size, margin=args.margin, cloud_points=args.cloud_points,
+        seed=args.seed, name=args.name)
+    command_line = " ".join(["astralis world import", *sys.argv[3:]]) if \
+        sys.argv[1:3] == ["world", "import"] else None
+    console = Console(highlight=False)
+    try:
+        report = import_world(args.file, args.output, options, command=command_line)
+    except KeyboardInterrupt:
+        console.print(f"[yellow]interrupted[/]; {args.output} was not written")
+        return EXIT_INTERRUPTED
+    what = (f"{report.points:,} points" if report.kind == "cloud" else
+            f"{report.points:,} triangles")
+    if report.dropped:
+        what += f" ({report.dropped:,} with NaN or infinite coordinates dropped)"
+    console.print(f"[bold]{report.world}[/]: {what} in {report.units}, "
+                  f"site {report.site[0]:g} x {report.site[1]:g} m, {report.blocks:,} blocks, "
+                  f"areas {', '.join(report.areas)} ({report.seconds:.2f} s)")
+    if report.ground is not None:
+        share = f"ground by {report.ground}: {report.ground_share:.1%} of the points"
+        if report.classified_share is not None and report.ground != "classification":
+            share += f" (the file's classification: {report.classified_share:.1%})"
+        console.print(share)
+    if len(report.floors) > 1:
+        console.print("floors at " + ", ".join(f"{z:g}" for z in report.floors) + " m")
+    console.print("wrote " + ", ".join(p.name for p in report.files))
+    return 0
+
+
+@world_command("show")
+def _world_show(args: argparse.Namespace) -> int:
     from astralis_des.world.show import show_world
 
     out = args.output or str(Path("out") / f"world_{Path(args.world).stem}.rrd")
@@ -115,6 +223,13 @@ def _world(args: argparse.Namespace) -> int:
     for room, kind, reason in shown.skipped:
         print(f"  not placed in {room}: {kind} ({reason})")
     return 0
+
+
+@command("study")
+def _study(args: argparse.Namespace) -> int:
+    from astralis_des.studies.console import study_command
+
+    return study_command(args)
 
 
 @command("schema")

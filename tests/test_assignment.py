@@ -192,11 +192,27 @@ def test_mixed_keeps_the_human_out_of_a_high_risk_room() -> None:
     assert mixed.total_cost == pytest.approx(1 + 5 + 8 / 7)
 
 
+def test_greedy_takes_the_nearest_pair_first() -> None:
+    """Greedy nearest pairs the closest agent and room first, even when that costs more in
+    total than the optimal matching on the same travel times."""
+    # a1 at x=0, a2 at x=3; R0 at x=1, R1 at x=-3. Travel times (l2 / 1.5 m/s):
+    #   a1: R0 1/1.5, R1 3/1.5;  a2: R0 2/1.5, R1 6/1.5.
+    # Greedy: a1-R0 (the cheapest), then a2-R1: 7/1.5. Optimal: a1-R1 + a2-R0: 5/1.5.
+    agents = [Agent("a1", "uav", (0.0, 0.0, 0.0)), Agent("a2", "uav", (3.0, 0.0, 0.0))]
+    rooms = [RoomInfo("R0", (1.0, 0.0, 0.0), 0.9, 0.9), RoomInfo("R1", (-3.0, 0.0, 0.0), 0, 0)]
+    plan = assign(agents, rooms, PAPER, strategy="greedy")
+    assert [(p.agent, p.room) for p in plan.pairs] == [("a1", "R0"), ("a2", "R1")]
+    assert plan.total_cost == pytest.approx(7 / 1.5)
+    assert_allclose(plan.costs, [[1 / 1.5, 3 / 1.5], [2 / 1.5, 6 / 1.5]])
+    assert match(plan.costs, "scipy") == [(0, 1), (1, 0)]  # optimal: 5 / 1.5
+
+
 def test_unknown_strategy_lists_valid_names() -> None:
     """An unknown strategy raises UnknownEntry listing the valid ones."""
     with pytest.raises(UnknownEntry) as info:
-        assign(AGENTS, ROOMS, PAPER, strategy="greedy")
-    assert str(info.value) == "unknown assignment strategy 'greedy'; valid: mixed, naive"
+        assign(AGENTS, ROOMS, PAPER, strategy="auction")
+    assert str(info.value) == ("unknown assignment strategy 'auction'; "
+                               "valid: greedy, mixed, naive")
 
 
 def test_misspelt_strategy_suggests_the_close_name() -> None:
@@ -209,8 +225,9 @@ def test_unknown_solver_lists_valid_names() -> None:
     """An unknown solver raises UnknownEntry listing the valid ones."""
     with pytest.raises(UnknownEntry) as info:
         assign(AGENTS, ROOMS, PAPER, solver="hungarian")
-    assert str(info.value) == "unknown matching solver 'hungarian'; valid: networkx, scipy"
-    with pytest.raises(UnknownEntry, match="valid: networkx, scipy"):
+    assert str(info.value) == ("unknown matching solver 'hungarian'; "
+                               "valid: greedy, networkx, scipy")
+    with pytest.raises(UnknownEntry, match="valid: greedy, networkx, scipy"):
         match(np.ones((2, 2)), "hungarian")
 
 

@@ -38,6 +38,22 @@ def _networkx(cost: NDArray[np.float64]) -> list[tuple[int, int]]:
     return sorted((int(a[1]), int(mate[a][1])) for a in agents if a in mate)
 
 
+@SOLVERS.register("greedy")
+def _greedy(cost: NDArray[np.float64]) -> list[tuple[int, int]]:
+    """Not optimal on purpose: the cheapest remaining pair first, until a side runs out."""
+    order = np.argsort(cost, axis=None, kind="stable")
+    rows, cols = np.unravel_index(order, cost.shape)
+    used_a: set[int] = set()
+    used_r: set[int] = set()
+    pairs = []
+    for i, j in zip(rows.tolist(), cols.tolist(), strict=True):
+        if i not in used_a and j not in used_r:
+            pairs.append((i, j))
+            used_a.add(i)
+            used_r.add(j)
+    return sorted(pairs)
+
+
 def match(cost: NDArray[np.float64], solver: str = "scipy") -> list[tuple[int, int]]:
     """``(agent index, room index)`` pairs of a minimum-weight full matching."""
     if cost.size == 0:

@@ -1,4 +1,5 @@
-"""Assignment strategies by registry: ``mixed`` (Eq. 1 with W1, W2) and ``naive`` (distance)."""
+"""Assignment strategies by registry: ``mixed`` (Eq. 1 with W1, W2), ``naive`` (Eq. 1's
+distance alone) and ``greedy`` (nearest by travel time, one pair at a time)."""
 
 from __future__ import annotations
 
@@ -8,9 +9,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from astralis_des.assignment.eq1 import Agent, RoomInfo, Weights, eq1_costs
+from astralis_des.assignment.eq1 import Agent, RoomInfo, Weights, distances, eq1_costs
 from astralis_des.assignment.matching import match
 from astralis_des.assignment.rules import table4_action
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.registry import Registry
 
 
@@ -39,22 +41,54 @@ class Assignment:
 
 
 EXCLUDED = 1e9  # the cost a solver sees for an edge that does not exist
-Strategy = Callable[[Sequence[Agent], Sequence[RoomInfo], Weights], NDArray[np.float64]]
+Costs = Callable[[Sequence[Agent], Sequence[RoomInfo], Weights], NDArray[np.float64]]
+
+
+@dataclass(frozen=True)
+class Strategy:
+    """A cost matrix, and the matcher that pairs on it (None: the mission's solver)."""
+
+    costs: Costs
+    matcher: str | None = None
+
+    def __call__(self, agents: Sequence[Agent], rooms: Sequence[RoomInfo],
+                 weights: Weights) -> NDArray[np.float64]:
+        return self.costs(agents, rooms, weights)
+
+
 STRATEGIES: Registry[str, Strategy] = Registry("assignment strategy")
 
 
-@STRATEGIES.register("mixed")
+def register_strategy(name: str, matcher: str | None = None) -> Callable[[Costs], Costs]:
+    def add(costs: Costs) -> Costs:
+        STRATEGIES.register(name)(Strategy(costs, matcher))
+        return costs
+
+    return add
+
+
+@register_strategy("mixed")
 def mixed(agents: Sequence[Agent], rooms: Sequence[RoomInfo],
           weights: Weights) -> NDArray[np.float64]:
     """The paper's mixed heuristic: Eq. 1 with the risk and messiness weights."""
     return eq1_costs(agents, rooms, weights)
 
 
-@STRATEGIES.register("naive")
+@register_strategy("naive")
 def naive(agents: Sequence[Agent], rooms: Sequence[RoomInfo],
           weights: Weights) -> NDArray[np.float64]:
     """The paper's baseline: Eq. 1's normalised distance alone."""
     return eq1_costs(agents, rooms, Weights.zero())
+
+
+@register_strategy("greedy", matcher="greedy")
+def greedy(agents: Sequence[Agent], rooms: Sequence[RoomInfo],
+           weights: Weights) -> NDArray[np.float64]:
+    """Greedy nearest: the pair with the shortest travel time (Eq. 1's distance over the
+    kind's cruise speed, not normalised) goes first, then the next among those left; risk
+    and messiness are ignored."""
+    speeds = np.array([KIND_DEFAULTS[a.kind].speed for a in agents])
+    return np.asarray(distances(agents, rooms) / speeds[:, None])
 
 
 def assign(agents: Sequence[Agent], rooms: Sequence[RoomInfo], weights: Weights, *,
@@ -66,7 +100,9 @@ def assign(agents: Sequence[Agent], rooms: Sequence[RoomInfo], weights: Weights,
     ``reachable[i, j]`` false excludes the edge: its cost is infinite, the matching avoids it,
     and an agent left with only such edges stays unassigned (the room stays pending).
     """
-    costs = STRATEGIES.get(strategy)(agents, rooms, weights)
+    chosen = STRATEGIES.get(strategy)
+    costs = chosen(agents, rooms, weights)
+    solver = chosen.matcher or solver
     if reachable is not None:
         costs = np.where(reachable, costs, np.inf)
     finite = np.isfinite(costs)

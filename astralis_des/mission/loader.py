@@ -48,7 +48,7 @@ class Mission:
     def searched_segments(self) -> list[str]:
         order: list[str] = []
         for entry in self.spec.assignment.search:
-            segs = (self.world.segment_order(entry) if entry in self.world.buildings
+            segs = (self.world.segment_order(entry) if entry in self.world.groups
                     else [entry])
             order.extend(s for s in segs if s not in order)
         return order
@@ -119,11 +119,14 @@ def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None
         STRATEGIES.get(spec.assignment.strategy)
     except UnknownEntry as exc:
         raise doc.error(("assignment", "strategy"), str(exc)) from None
-    places = {*world.buildings, *world.segments}
+    if spec.scene.movers and not any(s.kind == "corridor" for s in world.spaces.values()):
+        raise doc.error(("scene", "movers"), f"world '{world.name}' has no corridors for "
+                        "moving obstacles to pace")
+    places = {*world.groups, *world.segments}
     for i, entry in enumerate(spec.assignment.search):
         if entry not in places:
             raise doc.error(("assignment", "search", i),
-                            f"'{entry}' is neither a building nor a segment; "
+                            f"'{entry}' is neither a building, a group of areas nor a segment; "
                             f"{suggest(entry, places)}")
     for room_id in spec.rooms.set:
         room(room_id, ("rooms", "set", room_id))

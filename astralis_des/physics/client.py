@@ -11,12 +11,13 @@ import pybullet as pb
 import pybullet_data
 
 from astralis_des.physics.quiet import quiet_c_output
-from astralis_des.world.model import World
+from astralis_des.world.model import BLOCK, World
 
 __all__ = ["GRAVITY", "PhysicsClient", "quiet_c_output"]
 
 GRAVITY = 9.81
 COMPOUND = 16  # shapes PyBullet keeps in one compound (MAX_COMPOUND_COLLISION_SHAPES)
+MESH_BOXES = 1000  # boxes in one mesh body: 8,000 vertices, under what one call may pass
 
 
 class PhysicsClient:
@@ -49,9 +50,41 @@ class PhysicsClient:
     def _add_static(self, world: World) -> list[int]:
         """Walls, slabs and obstacles; not what lies wholly below the ground plane (the ground
         floors' slabs): the plane is that floor already, and a wheel on a plane costs half what
-        it costs on a box."""
-        above = [s for s in world.solids if s.box.hi[2] > 1e-6]
-        return self.add_boxes([s.box.lo for s in above], [s.box.hi for s in above])
+        it costs on a box. An imported world's geometry as its ``collision`` says: its blocks
+        as static triangle meshes (thousands of box bodies would cost every step), or its
+        mesh, concave or in convex parts."""
+        above = [s for s in world.solids if s.box.hi[2] > 1e-6 and s.kind != BLOCK]
+        bodies = self.add_boxes([s.box.lo for s in above], [s.box.hi for s in above])
+        imported = world.imported
+        if imported is None:
+            return bodies
+        if imported.collision == "boxes":
+            blocks = world.block_array
+            return bodies + self.add_box_meshes(blocks[:, 0], blocks[:, 1])
+        mesh_file = imported.parts_file if imported.collision == "convex" else imported.mesh_file
+        flags = pb.GEOM_FORCE_CONCAVE_TRIMESH if imported.collision == "concave" else 0
+        shape = self.call("createCollisionShape", pb.GEOM_MESH, fileName=str(mesh_file),
+                          flags=flags)
+        return [*bodies, int(self.call("createMultiBody", 0, shape))]
+
+    def add_box_meshes(self, los: Any, his: Any) -> list[int]:
+        """Static triangle-mesh bodies of axis-aligned boxes, ``MESH_BOXES`` a body (what
+        PyBullet takes in one call from memory)."""
+        from astralis_des.world.freespace import boxes_to_mesh
+        from astralis_des.world.geometry import Box
+
+        lo, hi = np.asarray(los, dtype=float), np.asarray(his, dtype=float)
+        bodies = []
+        for start in range(0, len(lo), MESH_BOXES):
+            boxes = [Box(tuple(a), tuple(b)) for a, b in zip(lo[start:start + MESH_BOXES].tolist(),
+                                                             hi[start:start + MESH_BOXES].tolist(),
+                                                             strict=True)]
+            vertices, faces = boxes_to_mesh(boxes)
+            shape = self.call("createCollisionShape", pb.GEOM_MESH, vertices=vertices.tolist(),
+                              indices=faces.ravel().tolist(),
+                              flags=pb.GEOM_FORCE_CONCAVE_TRIMESH)
+            bodies.append(int(self.call("createMultiBody", 0, shape)))
+        return bodies
 
     def add_boxes(self, los: Any, his: Any) -> list[int]:
         """Static compound bodies of axis-aligned boxes given by their corners.

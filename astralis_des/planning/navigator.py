@@ -60,6 +60,15 @@ class Navigator:
             if way is None:
                 return Route(None, f"no way for a {robot.kind} to there")
             points = way + np.array([0.0, 0.0, robot.height])
+            if len(self.world.block_array):
+                from astralis_des.planning.blocks import round_blocks
+
+                rounded, reason = round_blocks(
+                    self.world, points, BODY_RADIUS[robot.kind] + self.cfg.margin,
+                    fly=robot.kind == "uav", floor=float(start[2]))
+                if rounded is None:
+                    return Route(None, reason)
+                points = rounded
             if self.method == "graph":
                 return Route(points)
             return self.refine(robot, points)
@@ -202,7 +211,8 @@ class Navigator:
         solids = self.world.solid_array
         boxes = np.concatenate([solids, self._furniture(np.array([*lo, z_lo]),
                                                         np.array([*hi, z_hi]))])
-        tall = (boxes[:, 0, 2] < z_hi) & (boxes[:, 1, 2] > z_lo)
+        tall = (boxes[:, 0, 2] < z_hi) & (boxes[:, 1, 2] > z_lo) & \
+            np.all((boxes[:, 0, :2] <= hi + CELL) & (boxes[:, 1, :2] >= lo - CELL), axis=1)
         for box in boxes[tall]:
             occupied |= np.all((centers >= box[0, :2] - CELL / 2) &
                                (centers <= box[1, :2] + CELL / 2), axis=1)

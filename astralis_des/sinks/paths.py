@@ -10,6 +10,9 @@ WORLD_TARGET = "world/target"
 WORLD_FURNITURE = "world/furniture"
 WORLD_ROADS = "world/roads"
 WORLD_OCCUPANCY = "world/occupancy"  # the planner's voxel map
+WORLD_BLOCKS = "world/blocks"  # an imported world's voxel boxes
+WORLD_MESH = "world/mesh"  # an imported mesh
+WORLD_CLOUD = "world/cloud"  # an imported cloud, downsampled
 MISSION_EVENTS = "mission/events"
 MISSION_ROUNDS = "mission/assignment"
 

@@ -15,7 +15,7 @@ from astralis_des.sinks.blueprint import blueprint
 from astralis_des.sinks.replay import log_lanes, log_metrics, log_rounds, metrics, task_lanes
 from astralis_des.sinks.sensor_log import log_detections, log_sensors
 from astralis_des.world.clutter import Placed
-from astralis_des.world.model import World
+from astralis_des.world.model import BLOCK, World
 
 if TYPE_CHECKING:
     from astralis_des.kernel.result import RunResult
@@ -208,10 +208,14 @@ def describe(record: Record) -> str:
 
 
 def log_solids(rr: Any, rec: Any, world: World) -> None:
-    """Walls, slabs and outdoor obstacles, once (static)."""
-    lo = np.array([s.box.lo for s in world.solids])
-    hi = np.array([s.box.hi for s in world.solids])
-    colors = [SOLID_COLORS.get(s.kind, OBSTACLE_COLOR) for s in world.solids]
+    """Walls, slabs and outdoor obstacles, once (static); an imported world's blocks, mesh
+    and cloud (:mod:`astralis_des.sinks.imported`)."""
+    from astralis_des.sinks.imported import log_imported
+
+    solids = [s for s in world.solids if s.kind != BLOCK]
+    lo = np.array([s.box.lo for s in solids]).reshape(-1, 3)
+    hi = np.array([s.box.hi for s in solids]).reshape(-1, 3)
+    colors = [SOLID_COLORS.get(s.kind, OBSTACLE_COLOR) for s in solids]
     rec.log(paths.WORLD_SOLIDS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
                                            colors=colors, fill_mode="solid"), static=True)
     if world.surfaces:
@@ -220,6 +224,7 @@ def log_solids(rr: Any, rec: Any, world: World) -> None:
         rec.log(paths.WORLD_ROADS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
                                               colors=[(60, 60, 65, 255)], fill_mode="solid"),
                 static=True)
+    log_imported(rr, rec, world)
 
 
 def log_rooms(rr: Any, rec: Any, world: World, states: Mapping[str, Any]) -> None:

@@ -11,8 +11,10 @@ from functools import lru_cache
 from pathlib import Path
 
 from astralis_des.world.geometry import Box
+from astralis_des.world.imported import Imported, area_rooms, ground_slab, load_geometry
 from astralis_des.world.model import Building, Door, Room, Segment, Solid, Space, World
 from astralis_des.world.spec import BuildingSpec, WorldSpec
+from astralis_des.yamlio import LocatedYaml
 
 
 @dataclass
@@ -23,7 +25,10 @@ class _Parts:
     solids: list[Solid]
 
 
-def build_world(spec: WorldSpec) -> World:
+def build_world(spec: WorldSpec, blocks: list[Solid] | None = None,
+                imported: Imported | None = None) -> World:
+    """The world of ``spec``: its buildings, areas and obstacles, and an imported world's
+    ``blocks`` (read from beside the file by :func:`load_world`)."""
     parts = _Parts({}, {}, {}, [])
     buildings = {b.id: _add_building(b, parts) for b in spec.buildings}
     for obstacle in spec.obstacles:
@@ -31,12 +36,18 @@ def build_world(spec: WorldSpec) -> World:
         sx, sy, sz = obstacle.size
         box = Box((cx - sx / 2, cy - sy / 2, 0.0), (cx + sx / 2, cy + sy / 2, sz))
         parts.solids.append(Solid(obstacle.kind, box, obstacle.kind))
+    if spec.areas:
+        rooms, segments = area_rooms(spec.areas)
+        parts.rooms.update(rooms)
+        parts.segments.update(segments)
+        parts.solids.append(ground_slab(spec.site.size))
+    parts.solids.extend(blocks or [])
     roads = tuple(Solid("road", _road_box(r.start, r.end, r.width), "road") for r in spec.roads)
     return World(
         name=spec.name, site=spec.site.size, buildings=buildings, segments=parts.segments,
         rooms=parts.rooms, spaces=parts.spaces, solids=tuple(parts.solids),
         stairs_passable_by={b.id: tuple(b.stairs_passable_by) for b in spec.buildings},
-        surfaces=roads,
+        surfaces=roads, imported=imported,
     )
 
 
@@ -58,8 +69,13 @@ def load_world(path: Path) -> World:
 
     doc = load_yaml(path)
     check_unique_ids(doc, "buildings")
+    check_unique_ids(doc, "areas")
     spec = validate(WorldSpec, doc)
-    world = build_world(spec)
+    _check_areas(spec, doc)
+    blocks, imported = None, None
+    if spec.geometry is not None:
+        blocks, imported = load_geometry(spec.geometry, spec.source, doc)
+    world = build_world(spec, blocks, imported)
     footprints = [world.buildings[b.id].footprint for b in spec.buildings]
     for i, box in enumerate(footprints):
         if box.lo[0] < 0 or box.lo[1] < 0 or box.hi[0] > spec.site.size[0] or \
@@ -74,6 +90,20 @@ def load_world(path: Path) -> World:
                                 f"building {spec.buildings[i].id} overlaps building "
                                 f"{spec.buildings[j].id}")
     return world
+
+
+def _check_areas(spec: WorldSpec, doc: LocatedYaml) -> None:
+    buildings = {b.id for b in spec.buildings}
+    sx, sy = spec.site.size
+    for i, area in enumerate(spec.areas):
+        group = area.id.split(".")[0]
+        if group in buildings:
+            raise doc.error(("areas", i, "id"), f"'{group}' is a building's id; areas need a "
+                            "group of their own (the first part of the id)")
+        (x0, y0, _), (x1, y1, _) = area.box
+        if x0 < 0 or y0 < 0 or x1 > sx or y1 > sy:
+            raise doc.error(("areas", i, "box"), f"area {area.id} reaches outside the site "
+                            f"({sx:g} x {sy:g} m)")
 
 
 def _add_building(b: BuildingSpec, parts: _Parts) -> Building:

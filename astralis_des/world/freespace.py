@@ -21,7 +21,7 @@ from scipy import ndimage
 
 from astralis_des.errors import suggest
 from astralis_des.world.geometry import Box, FloatArray, boxes_array
-from astralis_des.world.model import World
+from astralis_des.world.model import BLOCK, World
 
 BoolArray = NDArray[np.bool_]
 IntArray = NDArray[np.int64]
@@ -273,7 +273,7 @@ def _room_free_space(world: World, room_id: str, extra: Sequence[Box],
     lo = np.array(room.box.lo[:2]) - margin
     hi = np.array(room.box.hi[:2]) + margin
     near = _solids_near(world, lo, hi, floor_z)
-    vertices, faces = boxes_to_mesh(near + list(extra))
+    vertices, faces = _with_mesh(world, *boxes_to_mesh(near + list(extra)), lo, hi, floor_z)
     floor = floor_mask(vertices, faces, lo, hi, floor_z, cell)
     occupied, boundary = wall_trace(vertices, faces, lo, hi, cell, floor_z + SLICE_HEIGHT, floor)
     open_floor = floor & ~occupied
@@ -289,14 +289,29 @@ def _room_free_space(world: World, room_id: str, extra: Sequence[Box],
 
 
 def _solids_near(world: World, lo: FloatArray, hi: FloatArray, floor_z: float) -> list[Box]:
-    """Solids reaching into the grid between just below the floor and above the slice."""
+    """Solids reaching into the grid between just below the floor and above the slice; not an
+    imported mesh's voxel blocks, whose triangles are used instead."""
     boxes = world.solid_array
     if len(boxes) == 0:
         return []
     z_lo, z_hi = floor_z - FLOOR_TOLERANCE, floor_z + SLICE_HEIGHT + FLOOR_TOLERANCE
     near = np.all((boxes[:, 0, :2] <= hi) & (boxes[:, 1, :2] >= lo), axis=1) & \
         (boxes[:, 0, 2] <= z_hi) & (boxes[:, 1, 2] >= z_lo)
-    return [world.solids[k].box for k in np.flatnonzero(near)]
+    has_mesh = world.imported is not None and world.imported.vertices is not None
+    return [world.solids[k].box for k in np.flatnonzero(near)
+            if not (has_mesh and world.solids[k].kind == BLOCK)]
+
+
+def _with_mesh(world: World, vertices: FloatArray, faces: IntArray, lo: FloatArray,
+               hi: FloatArray, floor_z: float) -> tuple[FloatArray, IntArray]:
+    """The boxes' triangles and, in an imported mesh world, the mesh's triangles near the
+    grid: floors and walls as they were modelled."""
+    if world.imported is None or world.imported.vertices is None:
+        return vertices, faces
+    z_lo, z_hi = floor_z - FLOOR_TOLERANCE, floor_z + SLICE_HEIGHT + FLOOR_TOLERANCE
+    more, tri = world.imported.triangles_near(np.array([*lo[:2], z_lo]),
+                                              np.array([*hi[:2], z_hi]))
+    return np.vstack([vertices, more]), np.vstack([faces, tri + len(vertices)])
 
 
 def _component_at(mask: BoolArray, centers: FloatArray, point: XY) -> BoolArray:

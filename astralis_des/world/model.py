@@ -14,7 +14,10 @@ import numpy as np
 from astralis_des.world.geometry import Box, FloatArray, boxes_array
 
 if TYPE_CHECKING:
+    from astralis_des.world.imported import Imported
     from astralis_des.world.routing import Router
+
+MAP_RESOLUTION = 0.2  # m, the planner's voxels in a world of boxes
 
 
 @dataclass(frozen=True)
@@ -72,6 +75,9 @@ class Space:
     box: Box
 
 
+BLOCK = "block"  # the kind of an imported world's voxel boxes
+
+
 @dataclass(frozen=True)
 class Solid:
     """Static geometry: a wall, slab or outdoor obstacle, as an axis-aligned box."""
@@ -109,6 +115,27 @@ class World:
     solids: tuple[Solid, ...]
     stairs_passable_by: dict[str, tuple[str, ...]] = field(default_factory=dict)
     surfaces: tuple[Solid, ...] = ()  # roads and such: drawn, walked on, never in the way
+    imported: Imported | None = None  # a digital twin's mesh, cloud and source
+
+    @property
+    def map_resolution(self) -> float:
+        """The planner's voxel: an imported world's own, else ``MAP_RESOLUTION``."""
+        return self.imported.voxel if self.imported is not None else MAP_RESOLUTION
+
+    @cached_property
+    def groups(self) -> set[str]:
+        """What a mission may search by name: buildings and groups of areas."""
+        return {*self.buildings, *(s.building for s in self.segments.values())}
+
+    @cached_property
+    def areas(self) -> list[Room]:
+        """The search areas (rooms out in the open, not in a building)."""
+        return [r for r in self.rooms.values() if r.building not in self.buildings]
+
+    @cached_property
+    def block_array(self) -> FloatArray:
+        """``(K, 2, 3)`` corners of the imported blocks (a subset of ``solid_array``)."""
+        return boxes_array([s.box for s in self.solids if s.kind == BLOCK])
 
     @cached_property
     def solid_array(self) -> FloatArray:
@@ -122,14 +149,18 @@ class World:
         return Router(self)
 
     def floor_below(self, point: tuple[float, ...] | FloatArray) -> float:
-        """Height of the floor under ``point``: a storey's level inside a building, else 0."""
+        """Height of the floor under ``point``: a storey's level inside a building, an area's
+        floor inside an area (the highest at or below the point), else 0."""
         x, y, z = float(point[0]), float(point[1]), float(point[2])
         for b in self.buildings.values():
             lo, hi = b.footprint.lo, b.footprint.hi
             if lo[0] <= x <= hi[0] and lo[1] <= y <= hi[1]:
                 storey = min(max(int((z + 0.1) // b.floor_height), 0), b.floors - 1)
                 return storey * b.floor_height
-        return 0.0
+        floors = [a.box.lo[2] for a in self.areas
+                  if a.box.lo[0] <= x <= a.box.hi[0] and a.box.lo[1] <= y <= a.box.hi[1]
+                  and a.box.lo[2] <= z + 0.1]
+        return max(floors, default=0.0)
 
     def on_floor(self, point: tuple[float, ...] | FloatArray) -> FloatArray:
         """``point`` brought down to the floor under it: where a robot stands, or the floor a

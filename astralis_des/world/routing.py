@@ -12,13 +12,16 @@ from scipy.sparse.csgraph import shortest_path
 
 from astralis_des.errors import InputError
 from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
-from astralis_des.world.model import World
+from astralis_des.world.model import BLOCK, World
 
 KINDS = ("uav", "ugv", "human")
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
 STAIR_RUN_FACTOR = 2.0  # horizontal run of a flight of stairs per metre of rise
 DOORWAY = 0.6  # m: routes cross a door square to its wall, from this far inside the room
 SNAP = 0.5  # m: a point this close to a room or corridor (in a wall, by a door) belongs to it
+# Not outdoor blockers: walls and slabs are inside footprints, and an imported world's blocks
+# (thousands) are left to the navigator, which flies or walks round them on a grid.
+NOT_BLOCKERS = ("wall", "slab", BLOCK)
 
 
 class Router:
@@ -100,8 +103,14 @@ class Router:
             outside = self._node(f"{b.id}:entrance", b.entrance)
             self._edge(outside, self.corridor_nodes[f"{b.id}.1.corridor"][-1])
             self.outdoor_nodes.append(outside)
+        for area in w.areas:  # a room in the open: its door is an outdoor place
+            door = self._node(f"{area.id}:door", area.door.center)
+            inside = self._node(f"{area.id}:inside", area.door_point("room", DOORWAY))
+            self._edge(self._node(area.id, area.center), inside)
+            self._edge(inside, door)
+            self.outdoor_nodes.append(door)
         for solid in [b.footprint for b in w.buildings.values()] + [
-            s.box for s in w.solids if s.kind not in ("wall", "slab")
+            s.box for s in w.solids if s.kind not in NOT_BLOCKERS
         ]:
             for cx in (solid.lo[0] - OUTDOOR_MARGIN, solid.hi[0] + OUTDOOR_MARGIN):
                 for cy in (solid.lo[1] - OUTDOOR_MARGIN, solid.hi[1] + OUTDOOR_MARGIN):
@@ -132,7 +141,7 @@ class Router:
 
     def _outdoor_blockers(self) -> FloatArray:
         boxes = [b.footprint for b in self.world.buildings.values()]
-        boxes += [s.box for s in self.world.solids if s.kind not in ("wall", "slab")]
+        boxes += [s.box for s in self.world.solids if s.kind not in NOT_BLOCKERS]
         return np.array([[[*b.lo[:2], -1.0], [*b.hi[:2], 1.0]] for b in boxes]).reshape(-1, 2, 3)
 
     def _outdoor_clear(self, p0: FloatArray, p1: FloatArray) -> np.ndarray:
@@ -159,6 +168,9 @@ class Router:
             raise InputError(f"point {where} is outside the world")
         if not self._outdoor_clear(p[None, :], p[None, :])[0]:
             raise InputError(f"point {where} is inside a building or obstacle")
+        blocks = self.world.block_array
+        if len(blocks) and np.all((p >= blocks[:, 0]) & (p < blocks[:, 1]), axis=1).any():
+            raise InputError(f"point {where} is inside a block of the imported world")
         return "outdoor"
 
     def _nearest_space(self, p: FloatArray) -> str | None:

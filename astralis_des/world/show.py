@@ -57,11 +57,14 @@ def show_world(world_file: str | Path, messiness: Sequence[float], out: str | Pa
 
 
 def _overview(world: World) -> Any:
-    """A 3-D view looking down at the first building from the south, steep enough to see
-    into its rooms over the walls."""
+    """A 3-D view looking down at the first building (or the whole site of a world without
+    buildings) from the south, steep enough to see into its rooms over the walls."""
     import rerun.blueprint as rrb
 
-    box = next(iter(world.buildings.values())).footprint
+    from astralis_des.world.geometry import Box
+
+    buildings = list(world.buildings.values())
+    box = buildings[0].footprint if buildings else Box((0.0, 0.0, 0.0), (*world.site, 0.0))
     cx, cy = (box.lo[0] + box.hi[0]) / 2, (box.lo[1] + box.hi[1]) / 2
     span = max(box.hi[0] - box.lo[0], box.hi[1] - box.lo[1])
     eye = rrb.EyeControls3D(position=(cx, box.lo[1] - 0.35 * span, 1.1 * span),

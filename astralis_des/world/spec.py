@@ -8,6 +8,7 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
+    NonNegativeInt,
     PositiveFloat,
     PositiveInt,
     field_validator,
@@ -74,12 +75,78 @@ class SiteSpec(Strict):
     size: tuple[PositiveFloat, PositiveFloat] = Field(description="outdoor area, metres")
 
 
+AREA_ID = r"^[A-Za-z][A-Za-z0-9]*\.[1-9][0-9]*\.[1-9][0-9]*\.[1-9][0-9]*$"
+Side = Literal["south", "west", "north", "east"]
+
+
+class AreaSpec(Strict):
+    """A search area: a box the team searches like a room, entered from one of its sides."""
+
+    id: str = Field(pattern=AREA_ID, description="GROUP.LEVEL.SEGMENT.AREA, like a room id; "
+                    "a mission's assignment.search names the group or a segment")
+    box: tuple[Vec3, Vec3] = Field(description="[[x0, y0, floor], [x1, y1, top]], metres")
+    entry: Side = Field("south", description="the side the team comes in from (its door)")
+
+    @model_validator(mode="after")
+    def _box_has_volume(self) -> AreaSpec:
+        lo, hi = self.box
+        if not all(a < b for a, b in zip(lo, hi, strict=True)):
+            raise ValueError(f"box: each coordinate of {list(lo)} must be below {list(hi)}")
+        return self
+
+
+class SourceSpec(Strict):
+    """Where an imported world came from, written by ``astralis world import``."""
+
+    file: str = Field(description="the imported file, relative to the world file")
+    format: str
+    kind: Literal["cloud", "mesh"]
+    bytes: NonNegativeInt
+    sha256: str = Field(pattern=r"^[0-9a-f]{64}$")
+    points: NonNegativeInt | None = Field(None, description="points read (a cloud)")
+    faces: NonNegativeInt | None = Field(None, description="triangles read (a mesh)")
+    dropped: NonNegativeInt = Field(0, description="points or vertices with NaN or infinite "
+                                    "coordinates, left out")
+    units: str = Field(description="the file's unit and where it was found")
+    scale: PositiveFloat = Field(description="metres per unit of the file")
+    up: Literal["y", "z"] = "z"
+    offset: Vec3 = Field(description="the file's coordinates (its units and axes) of this "
+                         "world's origin")
+    ground: str | None = Field(None, description="how the ground was found (a cloud)")
+    ground_share: float | None = Field(None, ge=0, le=1)
+    relief: float | None = Field(None, ge=0, description="m of ground relief flattened")
+
+
+class GeometrySpec(Strict):
+    """An imported world's geometry, in files beside the world file."""
+
+    voxel: PositiveFloat = Field(0.2, description="m: the blocks' voxel and the planner's map")
+    blocks: str | None = Field(None, description=".npz of merged voxel boxes: what blocks "
+                               "sight and routes, and (collision: boxes) collides")
+    mesh: str | None = Field(None, description=".obj of the imported mesh, in world "
+                             "coordinates: the replay, floors, and (concave) collision")
+    collision: Literal["boxes", "concave", "convex"] = "boxes"
+    parts: str | None = Field(None, description=".obj of convex parts (collision: convex)")
+    cloud: str | None = Field(None, description=".npz of a downsampled cloud for the replay")
+    floors: list[float] = Field(default_factory=list, description="floor heights found, m")
+
+    @model_validator(mode="after")
+    def _files_for_collision(self) -> GeometrySpec:
+        need = {"boxes": "blocks", "concave": "mesh", "convex": "parts"}[self.collision]
+        if getattr(self, need) is None:
+            raise ValueError(f"collision '{self.collision}' needs the file '{need}'")
+        return self
+
+
 class WorldSpec(Strict):
     name: str
     site: SiteSpec
-    buildings: list[BuildingSpec] = Field(min_length=1)
+    buildings: list[BuildingSpec] = Field(default_factory=list)
+    areas: list[AreaSpec] = Field(default_factory=list)
     obstacles: list[ObstacleSpec] = Field(default_factory=list)
     roads: list[RoadSpec] = Field(default_factory=list)
+    source: SourceSpec | None = None
+    geometry: GeometrySpec | None = None
 
     @field_validator("buildings")
     @classmethod
@@ -88,3 +155,9 @@ class WorldSpec(Strict):
         if len(ids) != len(set(ids)):
             raise ValueError(f"building ids must be unique, got {ids}")
         return buildings
+
+    @model_validator(mode="after")
+    def _something_to_search(self) -> WorldSpec:
+        if not self.buildings and not self.areas:
+            raise ValueError("a world needs buildings or areas: there is nothing to search")
+        return self

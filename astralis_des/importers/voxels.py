@@ -1,0 +1,137 @@
+"""Voxel occupancy and its collision geometry: merged boxes.
+
+Voxel ``(i, j, k)`` spans ``(i, j, k) * voxel`` to one voxel further, in the world frame (an
+imported world's origin is its voxel grid's corner). Boxes are index ranges
+``[i0, j0, k0, i1, j1, k1)``: runs along z, merged along y, then along x, all vectorised, so a
+few million voxels merge in about a second. The merge is greedy, not minimal: a box is kept
+whole only where whole runs line up.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import ndimage
+
+from astralis_des.errors import InputError
+from astralis_des.world.geometry import FloatArray
+
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+MAX_VOXELS = 400_000_000  # a dense grid larger than this (bytes) is refused, not attempted
+MAX_INDEX = 65_535  # boxes are stored as uint16 indices
+
+
+def grid_shape(extent: FloatArray, voxel: float, *, what: str = "the geometry") -> tuple[int, ...]:
+    """Cells covering ``extent`` (metres per axis) at ``voxel``; refused when too many."""
+    shape = tuple(max(math.ceil(float(e) / voxel - 1e-9), 1) for e in extent)
+    cells = math.prod(shape)
+    if cells > MAX_VOXELS or max(shape) > MAX_INDEX:
+        smallest = voxel * max((cells / MAX_VOXELS) ** (1 / len(shape)),
+                               max(shape) / MAX_INDEX)
+        raise InputError(f"{what} spans {' x '.join(f'{float(e):.0f}' for e in extent)} m: "
+                         f"{cells:,} voxels of {voxel:g} m are too many; pass --voxel "
+                         f"{math.ceil(smallest * 10) / 10:g} or more", key="--voxel")
+    return shape
+
+
+def voxel_index(points: FloatArray, voxel: float) -> IntArray:
+    """``(N, 3)`` voxel of each point; a point on a face belongs to the voxel below it, so a
+    floor at a multiple of the voxel does not spill into the voxel above."""
+    return np.floor(np.asarray(points) / voxel - 1e-6).astype(np.int64)
+
+
+def unique_rows(index: IntArray) -> IntArray:
+    """The distinct rows of ``(M, 3)`` integer indices, sorted (faster than ``unique(axis=0)``:
+    one flat key a row)."""
+    if len(index) == 0:
+        return np.zeros((0, 3), dtype=np.int64)
+    low = index.min(axis=0)
+    dims = tuple(int(d) for d in index.max(axis=0) - low + 1)
+    flat = np.unique(np.ravel_multi_index(tuple((index - low).T), dims))
+    return np.column_stack(np.unravel_index(flat, dims)).astype(np.int64) + low
+
+
+def column_tops(xy_index: IntArray, heights: FloatArray, shape: tuple[int, int], voxel: float,
+                close: int) -> NDArray[np.int32]:
+    """``(nx, ny)`` top of each occupied column, in voxels above the ground (0: none).
+
+    An aerial scan sees roofs and canopies, not what is below them: each column is solid from
+    the ground up to its highest point. A grey closing of ``close`` cells fills the holes that
+    the scan's point spacing leaves between the columns of one roof.
+    """
+    top = np.zeros(shape, dtype=np.float64)
+    np.maximum.at(top, (xy_index[:, 0], xy_index[:, 1]), heights)
+    if close > 1:
+        top = ndimage.grey_closing(top, size=(close, close))
+    return np.ceil(top / voxel - 1e-6).astype(np.int32)
+
+
+def boxes_from_columns(tops: NDArray[np.int32]) -> IntArray:
+    """Merged boxes of columns standing on ``k = 0`` up to ``tops``."""
+    i, j = np.nonzero(tops > 0)
+    runs = np.column_stack([i, j, j + 1, np.zeros_like(i), tops[i, j]]).astype(np.int64)
+    return _merge_x(_merge_y(runs))
+
+
+def boxes_from_voxels(occupied: BoolArray) -> IntArray:
+    """Merged boxes of a dense ``(nx, ny, nz)`` occupancy."""
+    return boxes_from_indices(np.argwhere(occupied))
+
+
+def boxes_from_indices(cells: IntArray) -> IntArray:
+    """Merged boxes of unique voxel indices ``(M, 3)``, in any order."""
+    if len(cells) == 0:
+        return np.zeros((0, 6), dtype=np.int64)
+    cells = cells[np.lexsort((cells[:, 2], cells[:, 1], cells[:, 0]))]
+    i, j, k = cells[:, 0], cells[:, 1], cells[:, 2]
+    start = np.ones(len(cells), dtype=bool)
+    start[1:] = (i[1:] != i[:-1]) | (j[1:] != j[:-1]) | (k[1:] != k[:-1] + 1)
+    first = np.flatnonzero(start)
+    last = np.append(first[1:], len(cells)) - 1
+    runs = np.column_stack([i[first], j[first], j[first] + 1, k[first], k[last] + 1])
+    return _merge_x(_merge_y(runs))
+
+
+def _merge_y(runs: IntArray) -> IntArray:
+    """z-runs ``(i, j, j + 1, k0, k1)`` side by side along y become ``(i, j0, j1, k0, k1)``."""
+    order = np.lexsort((runs[:, 1], runs[:, 4], runs[:, 3], runs[:, 0]))
+    r = runs[order]
+    same = np.zeros(len(r), dtype=bool)
+    same[1:] = (r[1:, 0] == r[:-1, 0]) & (r[1:, 3] == r[:-1, 3]) & (r[1:, 4] == r[:-1, 4]) & \
+        (r[1:, 1] == r[:-1, 2])
+    first = np.flatnonzero(~same)
+    last = np.append(first[1:], len(r)) - 1
+    return np.column_stack([r[first, 0], r[first, 1], r[last, 2], r[first, 3], r[first, 4]])
+
+
+def _merge_x(rects: IntArray) -> IntArray:
+    """Rectangles ``(i, j0, j1, k0, k1)`` side by side along x become boxes
+    ``[i0, j0, k0, i1, j1, k1)``."""
+    if len(rects) == 0:
+        return np.zeros((0, 6), dtype=np.int64)
+    order = np.lexsort((rects[:, 0], rects[:, 4], rects[:, 3], rects[:, 2], rects[:, 1]))
+    r = rects[order]
+    same = np.zeros(len(r), dtype=bool)
+    same[1:] = np.all(r[1:, 1:] == r[:-1, 1:], axis=1) & (r[1:, 0] == r[:-1, 0] + 1)
+    first = np.flatnonzero(~same)
+    last = np.append(first[1:], len(r)) - 1
+    return np.column_stack([r[first, 0], r[first, 1], r[first, 3],
+                            r[last, 0] + 1, r[first, 2], r[first, 4]])
+
+
+def box_corners(boxes: IntArray, voxel: float) -> FloatArray:
+    """``(K, 2, 3)`` corners in metres of index boxes."""
+    b = np.asarray(boxes, dtype=float).reshape(-1, 6) * voxel
+    return np.stack([b[:, :3], b[:, 3:]], axis=1)
+
+
+def occupancy_of_boxes(boxes: IntArray, shape: tuple[int, int, int]) -> BoolArray:
+    """The dense occupancy that ``boxes`` cover (what merging started from)."""
+    grid = np.zeros(shape, dtype=bool)
+    for i0, j0, k0, i1, j1, k1 in np.asarray(boxes, dtype=np.int64):
+        grid[i0:i1, j0:j1, k0:k1] = True
+    return grid

@@ -1,0 +1,91 @@
+"""``evaluate: mission``: a full mission per scenario and variant, in either fidelity.
+
+The scenario's mission is the base mission with the scenario's seed (its target, clutter and
+sounds), the variant's team at the drawn starts, each room's drawn risk and messiness, and the
+variant's strategy, weights, thresholds, fidelity and time limit.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from astralis_des.kinds import KINDS
+from astralis_des.studies.eval_assignment import team_ids
+from astralis_des.studies.evaluation import Metric, evaluation
+
+if TYPE_CHECKING:
+    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.mission.loader import Mission
+    from astralis_des.studies.draws import Scenario
+    from astralis_des.studies.factors import Setting
+    from astralis_des.studies.spec import Study, Variant
+
+METRICS = (
+    Metric("found", "found", "rate"),
+    Metric("time_to_find", "time to find", "mean", "s"),
+    Metric("human_high_risk_s", "human searching high-risk rooms", "mean", "s"),
+    Metric("ugv_high_mess_s", "UGV searching high-messiness rooms", "mean", "s"),
+    Metric("rooms_searched", "rooms searched", "mean"),
+    Metric("distance", "distance (team)", "mean", "m"),
+)
+
+
+def scenario_mission(study: Study, scenario: Scenario, s: Setting, outputs: bool) -> Mission:
+    """The mission a scenario runs under a variant's setting (checked like a file)."""
+    base = study.mission.spec
+    by_kind = {kind: [m for m in base.team if m.kind == kind] for kind in KINDS}
+    team = []
+    for ident, kind, k in team_ids(s.team):
+        like = by_kind[kind][k % len(by_kind[kind])] if by_kind[kind] else None
+        member = like.model_dump(mode="json", exclude_unset=True) if like else {}
+        start = scenario.start(kind, k)
+        team.append({**member, "id": ident, "kind": kind,
+                     "start": start if isinstance(start, str) else list(start)})
+    rooms = base.rooms.model_dump(mode="json", exclude_none=True)
+    for room, (risk, mess) in scenario.values(s.risk, s.messiness).items():
+        rooms["set"][room] = {**rooms["set"].get(room, {}), "risk": risk, "messiness": mess}
+    assignment = base.assignment.model_dump(mode="json")
+    assignment.update(strategy=s.strategy, weights=s.weights, high_risk=s.high_risk,
+                      high_messiness=s.high_messiness)
+    return study.mission.with_changes(
+        seed=scenario.seed, fidelity=s.fidelity, time_limit=s.time_limit, team=team,
+        rooms=rooms, assignment=assignment,
+        outputs={"dir": None, "events": outputs, "summary": outputs, "recording": outputs})
+
+
+@evaluation("mission", METRICS, tradeoff=("human_high_risk_s", "ugv_high_mess_s"))
+def evaluate_mission(study: Study, scenario: Scenario, variant: Variant,
+                     out_dir: Path | None) -> dict[str, Any]:
+    from astralis_des.kernel.simulation import Simulation
+
+    s = variant.setting
+    sim = Simulation(scenario_mission(study, scenario, s, out_dir is not None), out_dir=out_dir)
+    result = sim.run()
+    row: dict[str, Any] = {
+        "outcome": result.outcome, "found": result.found, "time_to_find": result.time_to_find,
+        "found_by": result.found_by, "end_time": result.end_time,
+        "target_room": result.target["room"], "rooms_searched": len(result.rooms_searched),
+        "rounds": len(result.rounds),
+        "tasks_failed": sum(st.tasks_failed for st in result.robots.values()),
+        "distance": sum(st.distance for st in result.robots.values()),
+    }
+    for kind in KINDS:
+        row[f"distance_{kind}"] = sum(st.distance for st in result.robots.values()
+                                      if st.kind == kind)
+    high_risk = {r for r, st in sim.rooms.items() if st.risk >= s.high_risk}
+    high_mess = {r for r, st in sim.rooms.items() if st.messiness >= s.high_messiness}
+    row["human_high_risk_s"] = search_time(sim, "human", high_risk)
+    row["ugv_high_mess_s"] = search_time(sim, "ugv", high_mess)
+    row["high_risk_rooms"] = len(high_risk)
+    row["high_mess_rooms"] = len(high_mess)
+    return row
+
+
+def search_time(sim: Simulation, kind: str, rooms: set[str]) -> float:
+    """Seconds robots of ``kind`` spent searching ``rooms`` (their Table IV actions, however
+    they ended; the way to the door is not counted). A UGV searches from the door or the
+    corridor, so this, not time inside, is what it is exposed to."""
+    return float(sum(res.end - res.start for task, res in sim.finished
+                     if task.room in rooms and task.action != "move"
+                     and sim.robots[task.robot].kind == kind))

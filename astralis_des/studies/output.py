@@ -1,0 +1,87 @@
+"""The study folder, written all or nothing: into a hidden sibling, renamed when complete.
+
+    table.csv  table.parquet   one row per scenario and variant
+    summary.csv                per variant and metric, with 95% intervals
+    report.md                  what the CLI prints
+    plots/*.png  plots/*.svg
+    study.yaml                 the study file as run
+    meta.json                  package version, seed, scenarios, backend, workers, wall time
+    failures.txt               the traceback of each failed row (if any)
+    scenarios/                 each mission's outputs (with recordings on)
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import shutil
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import pyarrow as pa
+
+from astralis_des.errors import InputError
+from astralis_des.studies.table import write_table
+
+if TYPE_CHECKING:
+    from astralis_des.studies.runner import StudyResult
+
+
+@contextmanager
+def staging(folder: Path | None) -> Iterator[Path | None]:
+    """A fresh hidden folder beside ``folder``, renamed to it on success, removed otherwise."""
+    if folder is None:
+        yield None
+        return
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{folder} exists and is not a folder", key="--out")
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    tmp = folder.parent / f".{folder.name}.partial-{os.getpid()}"
+    shutil.rmtree(tmp, ignore_errors=True)
+    tmp.mkdir()
+    try:
+        yield tmp
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    old = folder.parent / f".{folder.name}.old-{os.getpid()}"
+    if folder.exists():
+        folder.rename(old)
+    tmp.rename(folder)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def write_folder(result: StudyResult, folder: Path) -> Path:
+    with staging(folder) as tmp:
+        assert tmp is not None
+        fill_folder(result, tmp)
+    return folder
+
+
+def fill_folder(result: StudyResult, folder: Path) -> None:
+    from astralis_des import __version__
+    from astralis_des.studies.reports import report
+
+    study = result.study
+    write_table(result.table, folder)
+    summary = result.summary()
+    write_table(pa.Table.from_pylist(summary), folder, "summary")
+    (folder / "report.md").write_text("\n".join(t.markdown() for t in report(result)),
+                                      encoding="utf-8")
+    (folder / "study.yaml").write_text(study.text, encoding="utf-8")
+    meta = {"astralis_des": __version__, "study": study.name, "seed": study.spec.seed,
+            "scenarios": study.scenarios, "variants": [v.name for v in study.variants],
+            "evaluate": study.spec.evaluate, "rows": len(result.rows), "failed": result.failed,
+            "backend": result.backend, "workers": result.workers,
+            "wall_time_s": round(result.wall_time, 3), "python": platform.python_version(),
+            "mission": str(study.mission.path) if study.mission.path else None}
+    (folder / "meta.json").write_text(json.dumps(meta, indent=2) + "\n", encoding="utf-8")
+    if result.failures:
+        (folder / "failures.txt").write_text("\n".join(result.failures), encoding="utf-8")
+    if study.spec.outputs.plots:
+        from astralis_des.studies.plots import write_plots
+
+        write_plots(result, summary, folder / "plots")
