@@ -6,7 +6,8 @@ and readings go in columns."""
 from __future__ import annotations
 
 from collections import defaultdict
-from typing import TYPE_CHECKING, Any
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -14,20 +15,24 @@ from astralis_des.kernel.events import Record
 from astralis_des.sinks import paths
 
 if TYPE_CHECKING:
-    from astralis_des.physics.perception import KeptFrame, Perception
+    from astralis_des.physics.perception import KeptFrame, KeptScan, Perception
+
+Kept = TypeVar("Kept", "KeptFrame", "KeptScan")
+
+
+def _by_robot(items: Sequence[Kept]) -> dict[str, list[Kept]]:
+    """Kept frames or scans grouped by robot, each group in time order."""
+    groups: dict[str, list[Kept]] = defaultdict(list)
+    for item in items:
+        groups[item.robot].append(item)
+    return groups
 
 
 def log_sensors(rr: Any, rec: Any, perception: Perception) -> None:
-    by_robot: dict[str, list[KeptFrame]] = defaultdict(list)
-    for frame in perception.frames:
-        by_robot[frame.robot].append(frame)
-    for rid, frames in by_robot.items():
+    for rid, frames in _by_robot(perception.frames).items():
         _log_frames(rr, rec, paths.robot_camera(rid), frames)
-    scans: dict[str, list[Any]] = defaultdict(list)
-    for scan in perception.scans:
-        scans[scan.robot].append(scan)
-    for rid, kept in scans.items():
-        points = np.vstack([s.points for s in kept]) if kept else np.zeros((0, 3))
+    for rid, kept in _by_robot(perception.scans).items():
+        points = np.vstack([s.points for s in kept])
         rec.send_columns(paths.robot_lidar(rid),
                          indexes=[rr.TimeColumn(paths.TIMELINE, duration=[s.time for s in kept])],
                          columns=rr.Points3D.columns(positions=points).partition(
