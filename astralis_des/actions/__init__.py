@@ -20,5 +20,10 @@ ACTIONS: Registry[tuple[str, str], Action] = Registry("action")
 from astralis_des.actions import human, move, uav, ugv  # noqa: E402,F401  (they register)
 
 
+# Actions that take no room (the others search, peek into or go to one; ``move`` also takes
+# a point: ``x`` and ``y`` params).
+ROOMLESS = frozenset({"hover"})
+
+
 def actions_for(kind: str) -> list[str]:
     return [name for k, name in ACTIONS if k == kind]

@@ -100,11 +100,12 @@ def dwell(ctx: Context, robot: Robot, seconds: float) -> StepGen:
     return 0.0
 
 
-def go_to(ctx: Context, robot: Robot, goal_floor: tuple[float, ...]) -> ActionGen:
+def go_to(ctx: Context, robot: Robot, goal_floor: tuple[float, ...],
+          sense: bool = False) -> ActionGen:
     way = route(ctx, robot, goal_floor)
     if way.points is None:
         return failed(way.reason)
-    distance = yield from traverse(ctx, robot, way.points, sense=False)
+    distance = yield from traverse(ctx, robot, way.points, sense=sense)
     return result(TaskStatus.SUCCEEDED, "arrived", distance=distance)
 
 

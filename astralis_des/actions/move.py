@@ -10,7 +10,8 @@ from astralis_des.kinds import KINDS
 
 
 def move(ctx: Context, robot: Robot, task: Task) -> ActionGen:
-    """Params: ``point`` = ``center`` (default) or ``door`` with a room; or ``x``, ``y``, ``z``."""
+    """Params: ``point`` = ``center`` (default) or ``door`` with a room; or ``x``, ``y``, ``z``;
+    ``look`` = 1: watch for the target on the way (teleoperation does)."""
     room = room_of(ctx, task)
     if room is not None:
         ctx.sensor.scene.clutter(room.id)  # its furniture is there before the robot is
@@ -20,7 +21,7 @@ def move(ctx: Context, robot: Robot, task: Task) -> ActionGen:
         goal = (float(task.param("x", 0)), float(task.param("y", 0)), float(task.param("z", 0)))
     else:
         return failed("move needs a room or x and y")
-    return (yield from go_to(ctx, robot, goal))
+    return (yield from go_to(ctx, robot, goal, sense=bool(task.param("look", 0))))
 
 
 for _kind in KINDS:

@@ -41,7 +41,8 @@ class TaskHandler:
     def queued(self) -> list[Task]:
         """Tasks waiting, in the order they will run."""
         taken = self._taken()
-        return ([taken] if taken is not None else []) + list(self.queue.items)
+        ahead = [taken] if taken is not None and taken.id not in self._dropped else []
+        return ahead + list(self.queue.items)
 
     def submit(self, task: Task, *, front: bool = False) -> simpy.Event:
         done = self.env.event()

@@ -222,11 +222,14 @@ class Simulation:
         self.log.emit("mission_start", mission=spec.name, seed=spec.seed,
                       fidelity=spec.fidelity, target_room=self.target.room,
                       team=[m.id for m in spec.team])
-        self._timeline = self.env.process(search(self))
+        ends = [self.found]
+        if spec.assignment.auto:  # else the rounds come from commands (the API's assign)
+            self._timeline = self.env.process(search(self))
+            ends.append(self._timeline)
         for event in spec.timeline:
             self.env.process(scheduled(self, event))
         self._limit = self.env.timeout(spec.time_limit)
-        self._end = simpy.AnyOf(self.env, [self.found, self._timeline, self._limit])
+        self._end = simpy.AnyOf(self.env, [*ends, self._limit])
         for held in self._held:
             self._not_placed(*held)
         # The end stops env.run() itself: wrapping it in another condition would not do, as a

@@ -19,6 +19,7 @@ from astralis_des.mission.spec import (
 from astralis_des.registry import Registry
 
 if TYPE_CHECKING:
+    from astralis_des.assignment import Assignment
     from astralis_des.kernel.simulation import Simulation
 
 Handler = Callable[["Simulation", Any], None]
@@ -43,12 +44,7 @@ def search(sim: Simulation) -> Generator[simpy.Event, Any, str]:
                 sim.log.emit("team_lost", segment=segment)
                 return "team_lost"
             plan = sim.assignment_round(segment, pending, agents)
-            searches = {}
-            for pair in plan.pairs:
-                sim.enqueue(pair.agent, "move", pair.room, {"point": "door"},
-                            round=len(sim.rounds))
-                searches[pair.room] = sim.enqueue(pair.agent, pair.action, pair.room,
-                                                  round=len(sim.rounds))
+            searches = dispatch(sim, plan)
             yield simpy.AllOf(sim.env, list(searches.values()))
             for room, done in searches.items():
                 outcome = cast(ActionResult, done.value)
@@ -61,6 +57,24 @@ def search(sim: Simulation) -> Generator[simpy.Event, Any, str]:
                     pending.remove(room)
                     sim.log.emit("room_given_up", room=room, attempts=attempts[room])
     return "not_found"
+
+
+def dispatch(sim: Simulation, plan: Assignment) -> dict[str, simpy.Event]:
+    """Queue each matched agent's tasks, go to the door and search the room; the events
+    succeed with the searches' results, by room."""
+    searches = {}
+    for pair in plan.pairs:
+        sim.enqueue(pair.agent, "move", pair.room, {"point": "door"}, round=len(sim.rounds))
+        searches[pair.room] = sim.enqueue(pair.agent, pair.action, pair.room,
+                                          round=len(sim.rounds))
+    return searches
+
+
+def book(sim: Simulation, searches: dict[str, simpy.Event]) -> Generator[simpy.Event, Any, None]:
+    """Count the rooms of a round asked for by hand as searched once their searches succeed."""
+    yield simpy.AllOf(sim.env, list(searches.values()))
+    sim.searched.extend(room for room, done in searches.items()
+                        if cast(ActionResult, done.value).ok)
 
 
 def scheduled(sim: Simulation, event: Any) -> Generator[simpy.Event, Any, None]:

@@ -172,6 +172,8 @@ class AssignmentSpec(Strict):
         description="buildings or segment ids to search, in order; each round takes one segment")
     max_attempts: int = Field(2, ge=1, description="rounds a room may be tried in")
     start_at: NonNegativeFloat = Field(0.0, description="s the team waits before round 1")
+    auto: bool = Field(True, description="run the rounds of `search` on their own; false: the "
+                       "team waits for commands (astralis serve, chat)")
 
 
 class _At(Strict):

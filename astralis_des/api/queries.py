@@ -1,0 +1,174 @@
+"""Queries: the paper's Table II (avatar, location, robot) and the mission's status, task
+queues and events. They change nothing and are never logged."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from pydantic import Field
+
+from astralis_des import __version__
+from astralis_des.actions import actions_for
+from astralis_des.api.ops import OPS, Args, op
+from astralis_des.api.protocol import MAX_MESSAGE, PROTOCOL
+from astralis_des.kernel.robot import Motion
+
+if TYPE_CHECKING:
+    from astralis_des.api.service import Service
+    from astralis_des.kernel.robot import Robot
+    from astralis_des.kernel.tasks import Task
+
+TABLE_II_AVATAR = {"activity": "activity", "color": "color", "gender": "gender",
+                   "height": "height", "tied_to_chair": "tiedToChair"}
+MAX_EVENTS = 5000
+
+
+class RobotArgs(Args):
+    robot: str
+
+
+class OptionalRobot(Args):
+    robot: str | None = None
+
+
+class RoomArgs(Args):
+    room: str
+
+
+class EventsArgs(Args):
+    since: float | None = Field(None, description="simulated s: events at or after it")
+    after: int = Field(0, ge=0, description="events after this many (a reply's 'next')")
+    kinds: list[str] | None = None
+    robot: str | None = None
+    limit: int = Field(1000, ge=1, le=MAX_EVENTS)
+
+
+@op("help")
+def _help(svc: Service, args: Args) -> dict[str, Any]:
+    """The operations, their arguments (! = required) and what each does."""
+    return {"ops": {name: {"usage": OPS.get(name).usage(), "help": OPS.get(name).help,
+                           "command": OPS.get(name).command} for name in OPS}}
+
+
+@op("info")
+def _info(svc: Service, args: Args) -> dict[str, Any]:
+    """The mission, its team and their actions, the rooms, segments and addresses."""
+    sim, spec = svc.sim, svc.sim.mission.spec
+    world = sim.world
+    return {
+        "protocol": PROTOCOL, "version": __version__, "mission": spec.name, "seed": spec.seed,
+        "fidelity": spec.fidelity, "world": world.name, "time_limit": spec.time_limit,
+        "robots": {r.id: {"type": r.kind, "actions": actions_for(r.kind)}
+                   for r in sim.robots.values()},
+        "rooms": sorted(world.rooms),
+        "segments": {sid: list(seg.rooms) for sid, seg in world.segments.items()},
+        "auto_assignment": spec.assignment.auto, "max_message": MAX_MESSAGE,
+        "addresses": dict(svc.addresses),
+    }
+
+
+@op("status", OptionalRobot)
+def _status(svc: Service, args: OptionalRobot) -> dict[str, Any]:
+    """The mission's time, clock, outcome and each robot's state (or one robot's)."""
+    sim = svc.sim
+    robots = ([svc.robot(args.robot)] if args.robot is not None
+              else list(sim.robots.values()))
+    detection = next(iter(sim.log.of_kind("detection")), None)
+    return {
+        "t": svc.now, "clock": svc.clock.describe(), "running": svc.clock.running,
+        "pace": svc.clock.pace, "ended": svc.ended,
+        "outcome": svc.result.outcome if svc.result is not None else None,
+        "found": sim.found.triggered,
+        "found_by": detection["robot"] if detection is not None else None,
+        "rounds": len(sim.rounds), "rooms_searched": list(sim.searched),
+        "robots": {r.id: robot_state(svc, r) for r in robots},
+    }
+
+
+@op("avatar")
+def _avatar(svc: Service, args: Args) -> dict[str, Any]:
+    """The target avatar's attributes (Table II); its location once it has been found."""
+    target = svc.sim.target
+    out: dict[str, Any] = {TABLE_II_AVATAR[k]: v for k, v in target.avatar.items()}
+    out["found"] = svc.sim.found.triggered
+    if out["found"]:
+        out["location"] = list(target.position)
+        out["room"] = target.room
+    return out
+
+
+@op("location", RoomArgs)
+def _location(svc: Service, args: RoomArgs) -> dict[str, Any]:
+    """A room's location, messiness_level, risk and sound (Table II)."""
+    room = svc.room(args.room)
+    state = svc.sim.rooms[room.id]
+    return {"room": room.id, "location": list(room.center), "messiness_level": state.messiness,
+            "risk": state.risk, "sound": state.sound, "segment": room.segment,
+            "searched": room.id in svc.sim.searched}
+
+
+@op("robot", RobotArgs)
+def _robot(svc: Service, args: RobotArgs) -> dict[str, Any]:
+    """A robot's type, pose and command (Table II), and its state."""
+    return robot_state(svc, svc.robot(args.robot))
+
+
+@op("queue", RobotArgs)
+def _queue(svc: Service, args: RobotArgs) -> dict[str, Any]:
+    """A robot's running task and the tasks waiting, in the order they will run."""
+    robot = svc.robot(args.robot)
+    handler = svc.sim.handler(robot.id)
+    current = handler.current
+    return {"robot": robot.id, "current": task_dict(current) if current is not None else None,
+            "queued": [task_dict(t) for t in handler.queued]}
+
+
+@op("events", EventsArgs)
+def _events(svc: Service, args: EventsArgs) -> dict[str, Any]:
+    """The log's events at or after ``since`` and past ``after``, oldest first; ``next`` is
+    the ``after`` of the following page."""
+    records = svc.sim.log.records
+    kinds = set(args.kinds) if args.kinds is not None else None
+    out: list[dict[str, Any]] = []
+    index = args.after
+    while index < len(records) and len(out) < args.limit:
+        rec = records[index]
+        index += 1
+        if ((args.since is None or rec["t"] >= args.since)
+                and (kinds is None or rec["kind"] in kinds)
+                and (args.robot is None or rec.get("robot") == args.robot)):
+            out.append(rec)
+    return {"events": out, "next": index, "t": svc.now}
+
+
+# -- shared with the state stream ----------------------------------------------------------
+def robot_state(svc: Service, robot: Robot) -> dict[str, Any]:
+    now = svc.now
+    handler = svc.sim.handler(robot.id)
+    current = handler.current
+    position = robot.position(now)
+    travelled = robot.motion.travelled(now) if robot.motion is not None else 0.0
+    state = "faulted" if robot.faulted else ("busy" if current is not None else "idle")
+    return {"id": robot.id, "type": robot.kind, "pose": [float(v) for v in position],
+            "heading": heading_of(robot, now), "state": state,
+            "command": current.describe() if current is not None else None,
+            "task": current.id if current is not None else None,
+            "queued": len(handler.queued), "distance": robot.distance + travelled}
+
+
+def heading_of(robot: Robot, now: float) -> float:
+    """Radians from +x: along the kinematic path, or from the physics body."""
+    motion: Any = robot.motion
+    if isinstance(motion, Motion):
+        return motion.heading_at(now, robot.heading)
+    driver = getattr(motion, "driver", None)
+    if driver is not None:
+        v = driver.heading_vector()
+        return float(np.arctan2(v[1], v[0]))
+    return float(robot.heading)
+
+
+def task_dict(task: Task) -> dict[str, Any]:
+    return {"id": task.id, "action": task.action, "room": task.room,
+            "params": dict(task.params), "origin": task.origin, "round": task.round}
