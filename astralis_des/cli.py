@@ -36,12 +36,7 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     run = sub.add_parser("run", help="run a mission file and write its outputs")
     run.add_argument("mission", help="mission YAML file")
-    run.add_argument("--out", help="output folder (default: the mission's outputs.dir, "
-                     "else out/<mission name>)")
-    run.add_argument("--seed", type=int, help="override the mission's seed")
-    run.add_argument("--fidelity", choices=["kinematic", "physics"],
-                     help="override the mission's fidelity")
-    run.add_argument("--no-recording", action="store_true", help="skip the Rerun recording")
+    _add_mission_options(run)
     run.add_argument("--quiet", action="store_true", help="no progress bar or summary table")
     run.add_argument("--view", action="store_true", help="also stream the recording to a "
                      "Rerun viewer it spawns")
@@ -79,10 +74,22 @@ def _parser() -> argparse.ArgumentParser:
                        "or its traceback if it fails")
     study.add_argument("--variant", help="with --replay: only this variant")
     study.add_argument("--quiet", action="store_true", help="no progress bar or report")
+    from astralis_des.cli_api import add_api_parsers  # also registers their commands
+
+    add_api_parsers(sub, _add_mission_options)
     schema = sub.add_parser("schema", help="print the JSON Schema of mission or world files")
     schema.add_argument("--world", action="store_true", help="the world file's schema")
     schema.add_argument("-o", "--output", help="write to this file instead of stdout")
     return parser
+
+
+def _add_mission_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--out", help="output folder (default: the mission's outputs.dir, "
+                        "else out/<mission name>)")
+    parser.add_argument("--seed", type=int, help="override the mission's seed")
+    parser.add_argument("--fidelity", choices=["kinematic", "physics"],
+                        help="override the mission's fidelity")
+    parser.add_argument("--no-recording", action="store_true", help="skip the Rerun recording")
 
 
 def _positive(text: str) -> int:
@@ -250,8 +257,26 @@ def _schema(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     from rich.console import Console
 
-    from astralis_des.errors import InputError
     from astralis_des.kernel.simulation import Simulation
+
+    mission, out = mission_from_args(args)
+    console = Console(stderr=True, quiet=args.quiet)
+    try:
+        result = _with_progress(console, mission.spec.time_limit,
+                                lambda progress: Simulation(mission, out_dir=out,
+                                                            progress=progress,
+                                                            view=args.view).run())
+    except KeyboardInterrupt:
+        console.print(f"[yellow]interrupted[/]; what was recorded is in {out}/")
+        return EXIT_INTERRUPTED
+    if not args.quiet:
+        _print_summary(Console(), result, out)
+    return 0
+
+
+def mission_from_args(args: argparse.Namespace) -> tuple[Any, Path]:
+    """The mission file with the command line's overrides, and its output folder."""
+    from astralis_des.errors import InputError
     from astralis_des.mission.loader import load_mission
 
     mission = load_mission(args.mission)
@@ -265,18 +290,7 @@ def _run(args: argparse.Namespace) -> int:
     out = Path(args.out or mission.spec.outputs.dir or Path("out") / mission.name)
     if out.exists() and not out.is_dir():
         raise InputError(f"{out} exists and is not a folder", key="--out")
-    console = Console(stderr=True, quiet=args.quiet)
-    try:
-        result = _with_progress(console, mission.spec.time_limit,
-                                lambda progress: Simulation(mission, out_dir=out,
-                                                            progress=progress,
-                                                            view=args.view).run())
-    except KeyboardInterrupt:
-        console.print(f"[yellow]interrupted[/]; what was recorded is in {out}/")
-        return EXIT_INTERRUPTED
-    if not args.quiet:
-        _print_summary(Console(), result, out)
-    return 0
+    return mission, out
 
 
 def _with_progress(console: Any, limit: float, run: Callable[[Any], RunResult]) -> RunResult:

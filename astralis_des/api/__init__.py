@@ -5,7 +5,21 @@ team's commands, a PUB state stream, and :class:`Client`.
 to it. See ``docs/api.md`` for the operations.
 """
 
-from astralis_des.api.client import Client, Subscription
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 from astralis_des.api.protocol import ApiError, ApiTimeout
 
+if TYPE_CHECKING:
+    from astralis_des.api.client import Client, Subscription
+
 __all__ = ["ApiError", "ApiTimeout", "Client", "Subscription"]
+
+
+def __getattr__(name: str) -> Any:  # the client (and ZeroMQ) load on first use
+    if name in ("Client", "Subscription"):
+        from astralis_des.api import client
+
+        return getattr(client, name)
+    raise AttributeError(name)

@@ -11,7 +11,7 @@ from pydantic import Field
 
 from astralis_des.actions import ACTIONS, ROOMLESS, actions_for
 from astralis_des.api.ops import Args, NoArgs, op
-from astralis_des.api.protocol import ApiError
+from astralis_des.api.protocol import MAX_PACE, ApiError
 from astralis_des.errors import InputError, suggest
 from astralis_des.kernel.timeline import book, dispatch
 
@@ -19,7 +19,6 @@ if TYPE_CHECKING:
     from astralis_des.api.service import Service
     from astralis_des.kernel.robot import Robot
 
-MAX_PACE = 1000.0
 COMPASS = {"north": (0.0, 1.0), "south": (0.0, -1.0), "east": (1.0, 0.0),
            "west": (-1.0, 0.0)}
 Param = float | str

@@ -1,0 +1,103 @@
+"""The API's commands: ``astralis serve``, ``keys``, ``chat`` and ``teleop``."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from typing import Any
+
+from astralis_des.api.protocol import MAX_PACE
+from astralis_des.cli import command
+
+
+def parse_pace(text: str) -> float:
+    """``10``, ``10x`` or ``0.5x``: simulated seconds per wall second."""
+    try:
+        pace = float(text.strip().lower().removesuffix("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a pace like 1x or 10x") from None
+    if not 0.0 < pace <= MAX_PACE:
+        raise argparse.ArgumentTypeError(f"the pace must be above 0 and at most "
+                                         f"{MAX_PACE:g}x (got {text})")
+    return pace
+
+
+def _add_clock_options(parser: argparse.ArgumentParser) -> None:
+    clock = parser.add_mutually_exclusive_group()
+    clock.add_argument("--pace", type=parse_pace, default=1.0, metavar="FACTOR",
+                       help="simulated seconds per wall second, e.g. 1x (the default) or 10x")
+    clock.add_argument("--stepped", action="store_true",
+                       help="start paused: time moves only on step requests (or resume)")
+
+
+def add_api_parsers(sub: Any, add_mission_options: Callable[[Any], None]) -> None:
+    """serve, keys, chat and teleop."""
+    serve = sub.add_parser("serve", help="run a mission behind the ZeroMQ API: queries, "
+                           "commands and a state stream",
+                           description="Requests: JSON on a ROUTER socket (REQ and DEALER "
+                           "clients). State stream: a PUB socket, topics state.<robot> and "
+                           "event.<kind>. See docs/api.md.")
+    serve.add_argument("mission", help="mission YAML file")
+    serve.add_argument("--bind", default="tcp://127.0.0.1:5555",
+                       help="request address (default tcp://127.0.0.1:5555); an address "
+                       "other machines reach needs --curve-keys")
+    serve.add_argument("--stream", help="state stream address (default: the next port)")
+    serve.add_argument("--curve-keys", metavar="DIR", help="encrypt and authenticate with "
+                       "the CURVE keys in DIR (made by astralis keys DIR)")
+    serve.add_argument("--state-rate", type=float, default=10.0, metavar="HZ",
+                       help="robot states published per simulated second (default 10)")
+    serve.add_argument("--exit-on-end", action="store_true",
+                       help="stop when the mission ends (default: keep answering queries)")
+    serve.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    _add_clock_options(serve)
+    add_mission_options(serve)
+    keys = sub.add_parser("keys", help="make CURVE keys for serving beyond this machine")
+    keys.add_argument("folder", metavar="DIR", help="folder to write the keys to")
+    chat = sub.add_parser("chat", help="command the team in a line language (help, tab "
+                          "completion)")
+    chat.add_argument("mission", nargs="?", help="serve this mission file here and talk to "
+                      "it (default: connect to a server)")
+    chat.add_argument("--connect", metavar="ADDR", default="tcp://127.0.0.1:5555",
+                      help="the server (default tcp://127.0.0.1:5555)")
+    chat.add_argument("--curve-keys", metavar="DIR", help="the client keys for a CURVE server")
+    chat.add_argument("--timeout", type=float, default=5.0, help="s to wait for a reply")
+    _add_clock_options(chat)
+    add_mission_options(chat)
+    teleop = sub.add_parser("teleop", help="walk a robot (the human operator) with the arrow "
+                            "or WASD keys")
+    teleop.add_argument("robot", help="robot id, e.g. op1")
+    teleop.add_argument("--connect", metavar="ADDR", default="tcp://127.0.0.1:5555",
+                        help="the server (default tcp://127.0.0.1:5555)")
+    teleop.add_argument("--curve-keys", metavar="DIR", help="the client keys for a CURVE "
+                        "server")
+    teleop.add_argument("--step", type=float, default=0.5, metavar="M",
+                        help="metres a key press moves (default 0.5)")
+    teleop.add_argument("--timeout", type=float, default=2.0, help="s to wait for a reply")
+
+
+@command("serve")
+def _serve(args: argparse.Namespace) -> int:
+    from astralis_des.api.console import serve_command
+
+    return serve_command(args)
+
+
+@command("keys")
+def _keys(args: argparse.Namespace) -> int:
+    from astralis_des.api.console import keys_command
+
+    return keys_command(args)
+
+
+@command("chat")
+def _chat(args: argparse.Namespace) -> int:
+    from astralis_des.chat.repl import chat_command
+
+    return chat_command(args)
+
+
+@command("teleop")
+def _teleop(args: argparse.Namespace) -> int:
+    from astralis_des.chat.teleop import teleop_command
+
+    return teleop_command(args)
