@@ -74,9 +74,10 @@ def _parser() -> argparse.ArgumentParser:
                        "or its traceback if it fails")
     study.add_argument("--variant", help="with --replay: only this variant")
     study.add_argument("--quiet", action="store_true", help="no progress bar or report")
-    from astralis_des.cli_api import add_api_parsers  # also registers their commands
+    from astralis_des.cli_api import API_COMMANDS, add_api_parsers
 
     add_api_parsers(sub, _add_mission_options)
+    COMMANDS.update(API_COMMANDS)  # not by import: under python -m this module is __main__
     schema = sub.add_parser("schema", help="print the JSON Schema of mission or world files")
     schema.add_argument("--world", action="store_true", help="the world file's schema")
     schema.add_argument("-o", "--output", help="write to this file instead of stdout")

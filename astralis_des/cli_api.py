@@ -7,7 +7,18 @@ from collections.abc import Callable
 from typing import Any
 
 from astralis_des.api.protocol import MAX_PACE
-from astralis_des.cli import command
+
+
+Command = Callable[[argparse.Namespace], int]
+API_COMMANDS: dict[str, Command] = {}
+
+
+def command(name: str) -> Callable[[Command], Command]:
+    def add(fn: Command) -> Command:
+        API_COMMANDS[name] = fn
+        return fn
+
+    return add
 
 
 def parse_pace(text: str) -> float:

@@ -201,12 +201,15 @@ def _teleop(svc: Service, args: TeleopArgs) -> dict[str, Any]:
     handler = sim.handler(robot.id)
     last = svc.teleop_goals.get(robot.id)
     here = sim.world.on_floor(robot.position(svc.now))
-    going = last is not None and handler.current is not None and handler.current.id == last[0]
+    pending = [handler.current, *handler.queued] if handler.current else handler.queued
+    going = last is not None and any(t.id == last[0] for t in pending)  # not there yet
     base = last[1] if going and last is not None else here
     dx, dy = COMPASS[args.direction]
     goal = np.array([base[0] + dx * args.distance, base[1] + dy * args.distance, base[2]])
     _check_step(svc, robot, here, goal)
     svc.command_event("teleop", robot.id, direction=args.direction, distance=args.distance)
+    if going and last is not None and any(t.id == last[0] for t in handler.queued):
+        handler.cancel(last[0], reason="superseded by the next teleop step")
     params = {"x": float(goal[0]), "y": float(goal[1]), "z": float(goal[2]), "look": 1.0}
     sim.enqueue(robot.id, "move", None, params, origin="teleop", preempt=True)
     task = max(handler.queued, key=lambda t: t.id)

@@ -62,6 +62,7 @@ class Service:
         self.requests = 0
         self.errors = 0
         self._replies: OrderedDict[str, bytes] = OrderedDict()
+        sim.navigator.prepare()
         sim.start()
         self.clock.anchor(sim.env.now)
 

@@ -97,6 +97,12 @@ class Navigator:
         ok = self._valid(robot, points, BODY_RADIUS[robot.kind] + self.cfg.margin)
         return points[ok] if ok.any() else points[:0]
 
+    def prepare(self) -> None:
+        """Build the planner's map now rather than on the first route (a server does, so
+        that no request waits for it)."""
+        if self.method == "map":
+            _ = self.map
+
     # -- what is in the way ----------------------------------------------------------------
     @property
     def map_built(self) -> bool:
