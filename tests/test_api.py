@@ -72,7 +72,7 @@ def test_table_ii_robot(client: Client) -> None:
     robot = client.robot("uav2")
     assert robot["type"] == "uav" and robot["pose"] == [92.0, 60.0, 1.5]
     assert robot["command"] is None and robot["state"] == "idle"
-    with pytest.raises(ApiError, match="no robot 'uav9'; did you mean 'uav[12]'") as err:
+    with pytest.raises(ApiError, match=r"no robot 'uav9'; did you mean 'uav[12]'") as err:
         client.robot("uav9")
     assert err.value.code == "unknown_robot"
 
@@ -176,9 +176,9 @@ def test_assign_runs_a_round_and_queues_its_tasks(client: Client) -> None:
         assert [(t["action"], t["room"]) for t in queued] == [
             ("move", match["room"]), (match["action"], match["room"])]
     assert client.events(kinds=["assignment"])["events"][0]["segment"] == "A.2.1"
-    with pytest.raises(ApiError, match="no segment 'A.2.9'; did you mean"):
+    with pytest.raises(ApiError, match=r"no segment 'A\.2\.9'; did you mean"):
         client.assign("A.2.9")
-    with pytest.raises(ApiError, match="room A.1.1.1 is not in segment A.2.1"):
+    with pytest.raises(ApiError, match=r"room A\.1\.1\.1 is not in segment A\.2\.1"):
         client.assign("A.2.1", rooms=["A.1.1.1"])
 
 
@@ -277,3 +277,48 @@ def test_a_req_client_and_a_raw_dealer_work(server: Background) -> None:
         assert json.loads(dealer.recv())["ok"] is True
     finally:
         ctx.destroy(linger=0)
+
+
+def test_a_team_without_automatic_rounds_waits(manual: Mission) -> None:
+    """assignment.auto: false: no rounds, nobody moves, the mission runs to its time limit."""
+    from astralis_des import Simulation
+
+    result = Simulation(manual.with_changes(time_limit=60.0)).run()
+    assert result.outcome == "time_limit" and result.rounds == []
+    assert all(s.distance == 0.0 for s in result.robots.values())
+
+
+def test_physics_poses_come_from_the_bodies(manual: Mission) -> None:
+    background = Background(manual.with_changes(fidelity="physics"), running=False)
+    with Client(background.start(), timeout=10.0) as client:
+        start = client.robot("uav1")["pose"]
+        client.enqueue("uav1", "move", params={"x": start[0], "y": start[1] + 2.0})
+        client.step(by=0.5)
+        moving = client.robot("uav1")
+        assert moving["state"] == "busy" and moving["command"] == "move"
+        assert 0.0 < moving["pose"][1] - start[1] < 2.0  # under way, read from the body
+        client.step(by=6.0)
+        pose = client.robot("uav1")["pose"]
+        assert pose[1] == pytest.approx(start[1] + 2.0, abs=0.15)
+        assert client.events(kinds=["task_finished"])["events"][0]["status"] == "succeeded"
+        client.shutdown()
+    background.stop()
+
+
+def test_commands_are_in_the_recording(manual: Mission, tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    background = Background(manual, running=False, out_dir=tmp_path)
+    with Client(background.start(), timeout=5.0) as client:
+        client.enqueue("uav1", "hover", params={"duration": 2})
+        client.teleop("op1", "north")
+        client.step(by=1.0)
+        client.shutdown()
+    background.stop()
+    rerun = str(Path(sys.executable).with_name("rerun"))
+    shown = subprocess.run([rerun, "rrd", "print", "-vvv", str(tmp_path / "recording.rrd")],
+                           capture_output=True, text=True, check=True).stdout
+    for line in ("uav1 command enqueue hover", "op1 command teleop north", "command step",
+                 "command shutdown"):
+        assert line in shown, line

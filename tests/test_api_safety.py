@@ -19,7 +19,7 @@ import pytest
 import zmq
 
 from astralis_des import Mission
-from astralis_des.api import ApiError, ApiTimeout, Client
+from astralis_des.api import ApiTimeout, Client
 from astralis_des.api.local import Background
 from astralis_des.api.protocol import HARD_LIMIT, MAX_MESSAGE
 from astralis_des.api.security import check_bind, create_keys, is_local

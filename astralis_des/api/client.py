@@ -78,66 +78,66 @@ class Client:
 
     # -- queries ---------------------------------------------------------------------------
     def info(self) -> dict[str, Any]:
-        return self.request("info")  # type: ignore[no-any-return]
+        return self.request("info")
 
     def status(self, robot: str | None = None) -> dict[str, Any]:
-        return self.request("status", **_given(robot=robot))  # type: ignore[no-any-return]
+        return self.request("status", **_given(robot=robot))
 
     def avatar(self) -> dict[str, Any]:
-        return self.request("avatar")  # type: ignore[no-any-return]
+        return self.request("avatar")
 
     def location(self, room: str) -> dict[str, Any]:
-        return self.request("location", room=room)  # type: ignore[no-any-return]
+        return self.request("location", room=room)
 
     def robot(self, robot: str) -> dict[str, Any]:
-        return self.request("robot", robot=robot)  # type: ignore[no-any-return]
+        return self.request("robot", robot=robot)
 
     def queue(self, robot: str) -> dict[str, Any]:
-        return self.request("queue", robot=robot)  # type: ignore[no-any-return]
+        return self.request("queue", robot=robot)
 
     def events(self, since: float | None = None, after: int = 0,
                kinds: list[str] | None = None, robot: str | None = None,
                limit: int = 1000) -> dict[str, Any]:
-        return self.request("events", after=after, limit=limit,  # type: ignore[no-any-return]
+        return self.request("events", after=after, limit=limit,
                             **_given(since=since, kinds=kinds, robot=robot))
 
     # -- commands --------------------------------------------------------------------------
     def enqueue(self, robot: str, action: str, room: str | None = None,
                 params: dict[str, Any] | None = None, preempt: bool = False) -> dict[str, Any]:
-        return self.request("enqueue", robot=robot, action=action,  # type: ignore[no-any-return]
+        return self.request("enqueue", robot=robot, action=action,
                             preempt=preempt, **_given(room=room, params=params))
 
     def preempt(self, robot: str, action: str, room: str | None = None,
                 params: dict[str, Any] | None = None) -> dict[str, Any]:
-        return self.request("preempt", robot=robot, action=action,  # type: ignore[no-any-return]
+        return self.request("preempt", robot=robot, action=action,
                             **_given(room=room, params=params))
 
     def cancel(self, robot: str, task: int | None = None) -> dict[str, Any]:
-        return self.request("cancel", robot=robot, **_given(task=task))  # type: ignore[no-any-return]
+        return self.request("cancel", robot=robot, **_given(task=task))
 
     def pause(self) -> dict[str, Any]:
-        return self.request("pause")  # type: ignore[no-any-return]
+        return self.request("pause")
 
     def resume(self, pace: float | None = None) -> dict[str, Any]:
-        return self.request("resume", **_given(pace=pace))  # type: ignore[no-any-return]
+        return self.request("resume", **_given(pace=pace))
 
     def step(self, until: float | None = None, by: float | None = None,
              timeout: float = 120.0) -> dict[str, Any]:
         """Run a paused mission on; physics may take a while, hence the longer timeout."""
-        return self.request("step", timeout=timeout,  # type: ignore[no-any-return]
+        return self.request("step", timeout=timeout,
                             **_given(until=until, by=by))
 
     def assign(self, segment: str, rooms: list[str] | None = None,
                robots: list[str] | None = None) -> dict[str, Any]:
-        return self.request("assign", segment=segment,  # type: ignore[no-any-return]
+        return self.request("assign", segment=segment,
                             **_given(rooms=rooms, robots=robots))
 
     def teleop(self, robot: str, direction: str, distance: float = 0.5) -> dict[str, Any]:
-        return self.request("teleop", robot=robot,  # type: ignore[no-any-return]
+        return self.request("teleop", robot=robot,
                             direction=direction, distance=distance)
 
     def shutdown(self) -> dict[str, Any]:
-        return self.request("shutdown")  # type: ignore[no-any-return]
+        return self.request("shutdown")
 
     # -- the state stream ------------------------------------------------------------------
     def subscribe(self, *topics: str, address: str | None = None) -> Subscription:

@@ -125,7 +125,7 @@ class Service:
                 raise ApiError("unknown_op", f"no op '{request['op']}'; "
                                f"{suggest(str(request['op']), list(OPS))}") from None
             args = spec.parse(request)
-            if spec.command and self.ended and spec.name != "shutdown":
+            if spec.command and self.result is not None and spec.name != "shutdown":
                 raise ApiError("ended", f"the mission has ended ({self.result.outcome}, "
                                f"t = {self.now:.1f} s); only queries are answered")
             result = spec.fn(self, args)

@@ -198,7 +198,8 @@ class RerunRecorder:
 def describe(record: Record) -> str:
     """One line a person can read, e.g. ``uav1 task_finished spiral_inward A.1.1.2: ...``."""
     parts = [record.get("robot", ""), record["kind"]]
-    for key in ("action", "room", "status", "message", "segment", "outcome", "reason"):
+    for key in ("op", "action", "room", "direction", "status", "message", "segment", "outcome",
+                "reason"):
         if record.get(key) not in (None, ""):
             parts.append(str(record[key]))
     if record["kind"] == "assignment":
