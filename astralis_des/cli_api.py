@@ -8,7 +8,6 @@ from typing import Any
 
 from astralis_des.api.protocol import MAX_PACE
 
-
 Command = Callable[[argparse.Namespace], int]
 API_COMMANDS: dict[str, Command] = {}
 
