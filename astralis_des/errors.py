@@ -36,7 +36,21 @@ class InputError(Exception):
 def suggest(word: str, choices: Iterable[str]) -> str:
     """A ``did you mean`` hint for an unknown word, or the list of valid words."""
     options = sorted(set(choices))
-    close = difflib.get_close_matches(word, options, n=1, cutoff=0.6)
-    if close:
-        return f"did you mean '{close[0]}'?"
+    close = difflib.get_close_matches(word, options, n=5, cutoff=0.6)
+    if close:  # of the close ones: the fewest edits, then two letters swapped, then difflib's
+        best = min(close, key=lambda c: (edits(word, c), sorted(c) != sorted(word),
+                                         close.index(c)))
+        return f"did you mean '{best}'?"
     return "valid: " + ", ".join(options)
+
+
+def edits(a: str, b: str) -> int:
+    """Insertions, deletions, substitutions and swaps of neighbours from ``a`` to ``b``."""
+    d = [[i + j if i * j == 0 else 0 for j in range(len(b) + 1)] for i in range(len(a) + 1)]
+    for i in range(1, len(a) + 1):
+        for j in range(1, len(b) + 1):
+            cost = a[i - 1] != b[j - 1]
+            d[i][j] = min(d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost)
+            if i > 1 and j > 1 and a[i - 1] == b[j - 2] and a[i - 2] == b[j - 1]:
+                d[i][j] = min(d[i][j], d[i - 2][j - 2] + 1)
+    return d[-1][-1]

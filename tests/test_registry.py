@@ -28,3 +28,14 @@ def test_an_unknown_action_suggests_the_nearest() -> None:
     """A typo gets a 'did you mean'."""
     with pytest.raises(UnknownEntry, match="did you mean 'uav/spiral_inward'"):
         ACTIONS.get(("uav", "spiral_inwrd"))
+
+
+@pytest.mark.parametrize(("typo", "choices", "meant"), [
+    ("uva1", ["ugv1", "uav1", "uav2"], "uav1"),  # two letters swapped: one edit
+    ("stauts", ["stats", "status"], "status"),
+    ("sed", ["seed", "set", "name"], "seed"),
+    ("hovr", ["hover", "move"], "hover")])
+def test_suggest_prefers_the_fewest_edits(typo: str, choices: list[str], meant: str) -> None:
+    from astralis_des.errors import suggest
+
+    assert suggest(typo, choices) == f"did you mean '{meant}'?"

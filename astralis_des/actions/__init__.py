@@ -19,7 +19,6 @@ ACTIONS: Registry[tuple[str, str], Action] = Registry("action")
 
 from astralis_des.actions import human, move, uav, ugv  # noqa: E402,F401  (they register)
 
-
 # Actions that take no room (the others search, peek into or go to one; ``move`` also takes
 # a point: ``x`` and ``y`` params).
 ROOMLESS = frozenset({"hover"})

@@ -42,13 +42,16 @@ class Client:
         sock.connect(self.address)
         return sock
 
-    def request(self, op: str, *, timeout: float | None = None, **args: Any) -> Any:
+    def request(self, op: str, *, timeout: float | None = None, retries: int | None = None,
+                **args: Any) -> Any:
         """Send ``{"op": op, **args}``; the reply's result, or :class:`ApiError` (the server
-        refused: its code and message) or :class:`ApiTimeout` (no reply after the retries)."""
+        refused: its code and message) or :class:`ApiTimeout` (no reply after the retries).
+        ``timeout`` and ``retries`` override the client's for this request."""
         request_id = f"{self._prefix}-{next(self._ids)}"
         frame = json.dumps({"op": op, "id": request_id, **args}).encode()
         wait = self.timeout if timeout is None else timeout
-        for _ in range(1 + self.retries):
+        tries = 1 + (self.retries if retries is None else retries)
+        for _ in range(tries):
             self._sock.send_multipart([b"", frame])
             reply = self._await(request_id, wait)
             if reply is not None:
@@ -58,7 +61,6 @@ class Client:
                 raise ApiError(str(error.get("code", "error")), str(error.get("message", "")))
         self._sock.close(linger=0)  # start clean: nothing stale queued for a dead server
         self._sock = self._connect()
-        tries = 1 + self.retries
         raise ApiTimeout(f"no reply from {self.address} to '{op}' after {tries} "
                          f"{'try' if tries == 1 else 'tries'} of {wait:g} s")
 
@@ -97,9 +99,9 @@ class Client:
 
     def events(self, since: float | None = None, after: int = 0,
                kinds: list[str] | None = None, robot: str | None = None,
-               limit: int = 1000) -> dict[str, Any]:
+               limit: int = 1000, last: int | None = None) -> dict[str, Any]:
         return self.request("events", after=after, limit=limit,
-                            **_given(since=since, kinds=kinds, robot=robot))
+                            **_given(since=since, kinds=kinds, robot=robot, last=last))
 
     # -- commands --------------------------------------------------------------------------
     def enqueue(self, robot: str, action: str, room: str | None = None,

@@ -60,8 +60,8 @@ OPS: Registry[str, Op] = Registry("op")
 def op(name: str, args: type[Args] = NoArgs, *,
        command: bool = False) -> Callable[[Handler], Handler]:
     def add(fn: Handler) -> Handler:
-        first = (fn.__doc__ or "").strip().splitlines()
-        OPS.register(name)(Op(name, fn, args, command, first[0] if first else ""))
+        first = (fn.__doc__ or "").strip().split("\n\n")[0]  # the first paragraph
+        OPS.register(name)(Op(name, fn, args, command, " ".join(first.split())))
         return fn
 
     return add

@@ -42,6 +42,7 @@ class EventsArgs(Args):
     kinds: list[str] | None = None
     robot: str | None = None
     limit: int = Field(1000, ge=1, le=MAX_EVENTS)
+    last: int | None = Field(None, ge=1, le=MAX_EVENTS, description="only the last N of them")
 
 
 @op("help")
@@ -126,20 +127,32 @@ def _queue(svc: Service, args: RobotArgs) -> dict[str, Any]:
 
 @op("events", EventsArgs)
 def _events(svc: Service, args: EventsArgs) -> dict[str, Any]:
-    """The log's events at or after ``since`` and past ``after``, oldest first; ``next`` is
-    the ``after`` of the following page."""
+    """The log's events at or after ``since`` and past ``after``, oldest first (or only the
+    ``last`` N); ``next`` is the ``after`` of the following page, ``total`` the log's length."""
     records = svc.sim.log.records
     kinds = set(args.kinds) if args.kinds is not None else None
+
+    def wanted(rec: dict[str, Any]) -> bool:
+        return ((args.since is None or rec["t"] >= args.since)
+                and (kinds is None or rec["kind"] in kinds)
+                and (args.robot is None or rec.get("robot") == args.robot))
+
     out: list[dict[str, Any]] = []
+    if args.last is not None:  # from the end backwards, then in order
+        index = len(records)
+        for back in range(len(records) - 1, args.after - 1, -1):
+            if wanted(records[back]):
+                out.append(records[back])
+                if len(out) == args.last:
+                    break
+        return {"events": out[::-1], "next": index, "total": index, "t": svc.now}
     index = args.after
     while index < len(records) and len(out) < args.limit:
         rec = records[index]
         index += 1
-        if ((args.since is None or rec["t"] >= args.since)
-                and (kinds is None or rec["kind"] in kinds)
-                and (args.robot is None or rec.get("robot") == args.robot)):
+        if wanted(rec):
             out.append(rec)
-    return {"events": out, "next": index, "t": svc.now}
+    return {"events": out, "next": index, "total": len(records), "t": svc.now}
 
 
 # -- shared with the state stream ----------------------------------------------------------

@@ -20,6 +20,7 @@ from astralis_des.registry import Registry
 
 LAST_EVENTS = 10  # events shown by a bare ``events``
 SINCE_EVENTS = 50  # at most this many from ``events since T``
+MAX_EVENTS = 1000  # the most ``events N`` shows
 
 
 @dataclass(frozen=True)
@@ -213,8 +214,9 @@ def _events(words: list[str], team: Team) -> Parsed:
                                  "limit": SINCE_EVENTS})
     _at_most(words, 1, usage)
     last = number(words[0]) if words else LAST_EVENTS
-    if last is None or last < 1 or last != int(last):
-        raise ChatError(f"events: '{words[0]}' is not a count; usage: {usage}")
+    if last is None or not 1 <= last <= MAX_EVENTS or last != int(last):
+        raise ChatError(f"events: '{words[0]}' is not a count from 1 to {MAX_EVENTS}; "
+                        f"usage: {usage}")
     return Parsed("tail", {"last": int(last)}, local=True)
 
 
@@ -311,12 +313,17 @@ def help_rows(word: str | None, team: Team) -> list[tuple[str, str]]:
         return [*rows, ("ROBOT VERB ...", "a task for a robot: help ROBOT lists its verbs")]
     if word in team.robots:
         verbs = robots.verbs_of(word, team)
-        return [(v.usage(word), v.help) for v in verbs.values()]
+        named = robots.friendly_verbs(word, team)
+        actions = [name for name in verbs if name not in named]
+        rows = [(verbs[name].usage(word), verbs[name].help) for name in named]
+        if actions:
+            rows.append((f"{word} ACTION [ROOM]", f"its actions by name: {', '.join(actions)}"))
+        return rows
     name = ALIASES.get(word.lower(), word.lower())
     if name in COMMANDS:
         found = COMMANDS.get(name)
         return [(found.usage, found.help)]
-    rows = [(f"{kind} {v.usage()}" if kind != robots.ANY_KIND else v.usage(), v.help)
+    rows = [(v.usage(kind.upper() if kind != robots.ANY_KIND else "ROBOT"), v.help)
             for (kind, name), v in ((k, robots.VERBS.get(k)) for k in robots.VERBS)
             if name == word.lower()]
     if not rows:

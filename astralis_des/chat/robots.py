@@ -38,7 +38,7 @@ class RobotVerb:
             where += f" [{self.number.upper()}]"
         if self.variants:
             where += f" [{'|'.join(self.variants)}]"
-        return f"{robot} {self.name}{where} [key=value ...] [now]"
+        return f"{robot} {self.name}{where}"
 
     def actions(self) -> set[str]:
         return {self.action, *self.variants.values()}
@@ -120,7 +120,8 @@ def parse_robot_line(robot: str, words: list[str], team: Team) -> tuple[str, dic
 def _place(robot: str, verb: RobotVerb, rest: list[str],
            team: Team) -> tuple[str, str | None, dict[str, Any]]:
     """The room (or point, or number) and the variant of a robot line."""
-    action, room, params = verb.action, None, {}
+    room: str | None
+    action, room, params = verb.action, None, dict[str, Any]()
     chosen = [w.lower() for w in rest if w.lower() in verb.variants]
     if len(chosen) > 1:
         raise ChatError(f"{robot} {verb.name}: one of {', '.join(verb.variants)}, not "

@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Callable, Iterable
 from typing import Any
@@ -14,6 +15,8 @@ from rich.text import Text
 
 from astralis_des.chat.language import Parsed
 from astralis_des.registry import Registry
+
+log = logging.getLogger(__name__)
 
 Show = Callable[[Parsed, Any], RenderableType]
 SHOWS: Registry[str, Show] = Registry("reply")
@@ -26,7 +29,10 @@ def shows(op: str) -> Callable[[Show], Show]:
 def reply(parsed: Parsed, result: Any) -> RenderableType:
     """The reply to ``parsed``, as shown; an op without its own form as key: value lines."""
     if parsed.op in SHOWS:
-        return SHOWS.get(parsed.op)(parsed, result)
+        try:
+            return SHOWS.get(parsed.op)(parsed, result)
+        except (KeyError, TypeError, ValueError):  # a reply of another version's shape
+            log.warning("cannot show the reply to %s", parsed.op, exc_info=True)
     if isinstance(result, dict):
         return Text("\n".join(f"{k}: {v}" for k, v in result.items()))
     return Text(str(result))
@@ -38,17 +44,23 @@ def where(pose: Iterable[float] | None) -> str:
     return "(" + ", ".join(f"{v:.1f}" for v in pose) + ")"
 
 
+def fmt(value: Any) -> str:
+    """A value of a reply as a person reads it: floats to 2 decimals."""
+    if isinstance(value, float):
+        return f"{value:.2f}".rstrip("0").rstrip(".")
+    return str(value)
+
+
 def task_text(task: dict[str, Any]) -> str:
-    """``12 spiral_inward A.2.1.3`` or ``13 move to (70.0, 60.0)``."""
+    """``spiral_inward A.2.1.3`` or ``move to (70.0, 60.0)``."""
     params = dict(task.get("params") or {})
     target = task.get("room")
     if target is None and "x" in params and "y" in params:
         target = f"to ({params.pop('x'):.1f}, {params.pop('y'):.1f})"
         params.pop("z", None)
         params.pop("look", None)
-    extra = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
-                     for k, v in params.items())
-    return " ".join(str(p) for p in (task["id"], task["action"], target, extra) if p)
+    extra = " ".join(f"{k}={fmt(v)}" for k, v in params.items())
+    return " ".join(str(p) for p in (task["action"], target, extra) if p)
 
 
 def clock_line(result: dict[str, Any]) -> str:
@@ -56,9 +68,13 @@ def clock_line(result: dict[str, Any]) -> str:
                else "mission running")
     found = (f"; target found by {result['found_by']}" if result.get("found")
              and result.get("found_by") else "")
+    rounds, searched = result.get("rounds", 0), len(result.get("rooms_searched", []))
     return (f"t = {result['t']:.1f} s, clock {result['clock']}; {mission}{found}; "
-            f"{result.get('rounds', 0)} assignment rounds, "
-            f"{len(result.get('rooms_searched', []))} rooms searched")
+            f"{plural(rounds, 'assignment round')}, {plural(searched, 'room')} searched")
+
+
+def plural(n: int, what: str) -> str:
+    return f"{n} {what}{'' if n == 1 else 's'}"
 
 
 @shows("status")
@@ -84,13 +100,14 @@ def _robot(parsed: Parsed, r: dict[str, Any]) -> RenderableType:
 @shows("location")
 def _location(parsed: Parsed, r: dict[str, Any]) -> RenderableType:
     return Text(f"{r['room']} (segment {r['segment']}) at {where(r['location'])}: messiness "
-                f"{r['messiness_level']:.2f}, risk {r['risk']:.2f}, sound {r['sound']:.2f}; "
+                f"{fmt(r['messiness_level'])}, risk {fmt(r['risk'])}, sound {fmt(r['sound'])}; "
                 f"{'searched' if r['searched'] else 'not searched yet'}")
 
 
 @shows("avatar")
 def _avatar(parsed: Parsed, r: dict[str, Any]) -> RenderableType:
-    looks = ", ".join(f"{k} {v}" for k, v in r.items() if k not in ("found", "location", "room"))
+    looks = ", ".join(f"{k} {fmt(v)}" for k, v in r.items()
+                      if k not in ("found", "location", "room"))
     found = (f"found in {r['room']} at {where(r['location'])}" if r.get("found")
              else "not found yet")
     return Text(f"target: {looks}; {found}")
@@ -102,11 +119,13 @@ def _queue(parsed: Parsed, r: dict[str, Any]) -> RenderableType:
 
 
 def queue_text(r: dict[str, Any]) -> str:
-    running = f"running {task_text(r['current'])}" if r["current"] else "nothing running"
+    current = r["current"]
+    running = (f"running task {current['id']}: {task_text(current)}" if current
+               else "nothing running")
     if not r["queued"]:
         return f"{r['robot']}: {running}, nothing queued"
-    lines = [f"{r['robot']}: {running}; queued:"]
-    lines += [f"  {n}. {task_text(t)}" for n, t in enumerate(r["queued"], 1)]
+    lines = [f"{r['robot']}: {running}; queued, in order:"]
+    lines += [f"  task {t['id']}: {task_text(t)}" for t in r["queued"]]
     return "\n".join(lines)
 
 
@@ -117,10 +136,19 @@ def _events(parsed: Parsed, r: dict[str, Any]) -> RenderableType:
         return Text(f"no events since t = {parsed.args.get('since', 0):g} s")
     more = parsed.args.get("limit") == len(events)
     last = f"\n(more: events since {events[-1]['t']:g})" if more else ""
-    return Text(events_text(events) + last)
+    return unwrapped(events_text(events) + last)
+
+
+def unwrapped(text: str) -> Table:
+    """Lines cut at the terminal's edge (with an ellipsis) instead of wrapped."""
+    table = Table(box=None, show_header=False, pad_edge=False, padding=0)
+    table.add_column(no_wrap=True, overflow="ellipsis")
+    table.add_row(Text(text))
+    return table
 
 
 def events_text(events: list[dict[str, Any]]) -> str:
+    """One line per event."""
     return "\n".join(event_line(e) for e in events)
 
 
@@ -141,14 +169,14 @@ def _short(value: Any) -> str:
 
 @shows("enqueue")
 def _enqueue(parsed: Parsed, r: dict[str, Any]) -> RenderableType:
-    what = task_text({"id": "", **parsed.args}).strip()
+    what = task_text(parsed.args)
     return Text(f"queued task {r['task']} for {r['robot']}: {what} (position "
                 f"{r['position'] + 1})")
 
 
 @shows("preempt")
 def _preempt(parsed: Parsed, r: dict[str, Any]) -> RenderableType:
-    what = task_text({"id": "", **parsed.args}).strip()
+    what = task_text(parsed.args)
     stopped = (f"; task {r['interrupted']} interrupted" if r.get("interrupted") is not None
                else "")
     return Text(f"task {r['task']} for {r['robot']} runs now: {what}{stopped}")
@@ -183,7 +211,7 @@ def _step(parsed: Parsed, r: dict[str, Any]) -> RenderableType:
 def _assign(parsed: Parsed, r: dict[str, Any]) -> RenderableType:
     pairs = [f"{m['agent']} -> {m['action']} {m['room']}" for m in r["matching"]]
     lines = [f"round {r['round']} over {parsed.args['segment']}: "
-             f"{len(pairs)} task{'s' if len(pairs) != 1 else ''} queued"]
+             f"{plural(len(pairs), 'task')} queued"]
     lines += [f"  {p}" for p in pairs]
     if r["unassigned"]:
         lines.append(f"  unassigned: {', '.join(r['unassigned'])}")
