@@ -113,6 +113,21 @@ def test_curve_lets_in_only_the_clients_with_keys(urban_search: Mission,
         background.stop()
 
 
+def test_a_busy_port_is_one_line_and_nothing_written(tmp_path: Path) -> None:
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        run = subprocess.run([sys.executable, "-m", "astralis_des.cli", "serve", str(MISSION),
+                              "--bind", f"tcp://127.0.0.1:{port}", "--out",
+                              str(tmp_path / "out")], capture_output=True, text=True,
+                             timeout=60)
+    assert run.returncode == 2
+    assert run.stderr.strip() == (f"error: --bind: cannot bind tcp://127.0.0.1:{port}: "
+                                  "Address already in use")
+    assert not (tmp_path / "out").exists()
+
+
 def test_missing_keys_are_one_line(tmp_path: Path) -> None:
     run = subprocess.run([sys.executable, "-m", "astralis_des.cli", "serve", str(MISSION),
                           "--bind", f"tcp://0.0.0.0:{free_port()}", "--curve-keys",
@@ -187,6 +202,22 @@ def test_a_retried_command_runs_once(server: Background) -> None:
         assert replies[0] == replies[1]
         with Client(server.address) as client:
             assert len(client.queue("uav1")["queued"]) == 1
+    finally:
+        ctx.destroy(linger=0)
+
+
+def test_two_clients_counting_ids_alike_both_run(server: Background) -> None:
+    ctx = zmq.Context()
+    try:
+        for _ in range(2):  # each its own connection, both with id 1
+            dealer = ctx.socket(zmq.DEALER)
+            dealer.connect(server.address)
+            dealer.send_multipart([b"", b'{"op": "enqueue", "robot": "uav2", '
+                                   b'"action": "hover", "id": 1}'])
+            assert dealer.poll(5000)
+            assert json.loads(dealer.recv_multipart()[-1])["ok"]
+        with Client(server.address) as client:
+            assert len(client.queue("uav2")["queued"]) == 2
     finally:
         ctx.destroy(linger=0)
 

@@ -11,26 +11,26 @@ EXIT_INTERRUPTED = 130
 
 
 def serve_command(args: argparse.Namespace) -> int:
-    from astralis_des.api.security import check_bind
     from astralis_des.api.server import Server
     from astralis_des.api.service import Clock, Service
     from astralis_des.cli import mission_from_args
     from astralis_des.kernel.simulation import Simulation
 
-    check_bind(args.bind, args.curve_keys)  # before the world is built: fail fast
     if args.state_rate <= 0:
         from astralis_des.errors import InputError
 
         raise InputError(f"must be above 0 (got {args.state_rate:g})", key="--state-rate")
     mission, out = mission_from_args(args)
+    # the sockets before the mission: a bad or busy address fails with nothing written
+    server = Server(args.bind, stream=args.stream, curve_keys=args.curve_keys,
+                    state_rate=args.state_rate)
     console = Console(stderr=True, quiet=args.quiet, highlight=False)
-    service = Service(Simulation(mission, out_dir=out), Clock(args.pace, not args.stepped))
     try:
-        server = Server(service, args.bind, stream=args.stream, curve_keys=args.curve_keys,
-                        state_rate=args.state_rate)
+        service = Service(Simulation(mission, out_dir=out), Clock(args.pace, not args.stepped))
     except BaseException:
-        service.end()
+        server.close()
         raise
+    server.attach(service)
     spec = mission.spec
     console.print(f"[bold]{spec.name}[/] ({spec.fidelity}, seed {spec.seed}): requests on "
                   f"{server.address}, state stream on {server.stream}"

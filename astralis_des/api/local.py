@@ -47,12 +47,14 @@ class Background:
         a = self._args
         server = None
         try:
+            server = Server(a["bind"], stream=a["stream"], curve_keys=a["curve_keys"])
             sim = Simulation(a["mission"], out_dir=a["out_dir"])
             self._service = Service(sim, Clock(a["pace"], a["running"]))
-            server = Server(self._service, a["bind"], stream=a["stream"],
-                            curve_keys=a["curve_keys"])
+            server.attach(self._service)
             self.address, self.stream = server.address, server.stream
         except BaseException as exc:
+            if server is not None:
+                server.close()
             self.error = exc
             self._ready.set()
             return

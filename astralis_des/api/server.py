@@ -42,15 +42,14 @@ def stream_address(bind: str) -> str:
 
 
 class Server:
-    """Serve ``service`` on ``bind`` (requests) and ``stream`` (the PUB stream)."""
+    """Sockets on ``bind`` (requests) and ``stream`` (the PUB stream), bound at once so that
+    a bad address fails before any mission is built; :meth:`attach` gives them a service."""
 
-    def __init__(self, service: Service, bind: str = DEFAULT_BIND, *,
-                 stream: str | None = None, curve_keys: str | None = None,
-                 state_rate: float = 10.0) -> None:
+    def __init__(self, bind: str = DEFAULT_BIND, *, stream: str | None = None,
+                 curve_keys: str | None = None, state_rate: float = 10.0) -> None:
         stream = stream or stream_address(bind)
         check_bind(bind, curve_keys)
         check_bind(stream, curve_keys, key="--stream")
-        self.service = service
         self.ctx: zmq.Context[Any] = zmq.Context()
         self.router = self._socket(zmq.ROUTER)
         self.pub = self._socket(zmq.PUB)
@@ -63,13 +62,19 @@ class Server:
         except BaseException:
             self.close()
             raise
-        service.addresses.update(requests=self.address, stream=self.stream)
         self.state_period = 1.0 / state_rate
         self._next_state = 0.0
         self._slice = 0.05
         self.published = 0
+        self.service: Service
+
+    def attach(self, service: Service) -> Server:
+        """Serve this mission: its requests, its events and robot states on the stream."""
+        self.service = service
+        service.addresses.update(requests=self.address, stream=self.stream)
         service.sim.log.sinks.append(self._publish_event)
         service.after_advance.append(self._publish_states)
+        return self
 
     def _socket(self, kind: int) -> zmq.Socket[Any]:
         sock = self.ctx.socket(kind)
@@ -83,7 +88,9 @@ class Server:
         try:
             sock.bind(address)
         except zmq.ZMQError as exc:
-            raise InputError(f"cannot bind {address}: {exc}", key=key) from None
+            reason = zmq.strerror(exc.errno) if exc.errno is not None else str(exc)
+            raise InputError(f"cannot bind {address}: {reason}",
+                             key=key) from None
         return str(sock.getsockopt_string(zmq.LAST_ENDPOINT))
 
     # -- the loop --------------------------------------------------------------------------
@@ -132,7 +139,7 @@ class Server:
             reply = encode(ApiError("bad_request", f"a request is one frame of JSON, not "
                                     f"{len(body)}").reply())
         else:
-            reply = self.service.handle_frame(body[0])
+            reply = self.service.handle_frame(body[0], peer=envelope[0])
         try:
             self.router.send_multipart([*envelope, reply], zmq.NOBLOCK)
         except zmq.ZMQError:  # the peer is gone or not reading: its reply is dropped

@@ -26,7 +26,8 @@ if TYPE_CHECKING:
     from astralis_des.world.model import Room
 
 log = logging.getLogger(__name__)
-REPLAYS = 1024  # replies to commands kept by request id, so that a retry is not run twice
+REPLAYS = 1024  # replies to commands kept by connection and request id: a retry is not run
+# twice (and two clients that both count their ids from 1 do not meet)
 
 
 class Clock:
@@ -61,7 +62,7 @@ class Service:
         self.teleop_goals: dict[str, tuple[int, Any]] = {}  # robot -> (task, goal)
         self.requests = 0
         self.errors = 0
-        self._replies: OrderedDict[str, bytes] = OrderedDict()
+        self._replies: OrderedDict[tuple[bytes, Any], bytes] = OrderedDict()
         sim.navigator.prepare()
         sim.start()
         self.clock.anchor(sim.env.now)
@@ -90,13 +91,14 @@ class Service:
         return self.result
 
     # -- requests --------------------------------------------------------------------------
-    def handle_frame(self, frame: bytes) -> bytes:
-        """One request frame to its reply frame; never raises."""
+    def handle_frame(self, frame: bytes, peer: bytes = b"") -> bytes:
+        """One request frame (from the connection ``peer``) to its reply frame; never
+        raises."""
         request_id: Any = None
         try:
             request = decode(frame)
             request_id = request.get("id")
-            key = f"{request_id}" if request_id is not None else None
+            key = (peer, request_id) if request_id is not None else None
             if key is not None and key in self._replies:  # a client's retry of a command
                 return self._replies[key]
             reply = self.handle(request)
