@@ -74,7 +74,7 @@ def book(sim: Simulation, searches: dict[str, simpy.Event]) -> Generator[simpy.E
     """Count the rooms of a round asked for by hand as searched once their searches succeed."""
     yield simpy.AllOf(sim.env, list(searches.values()))
     sim.searched.extend(room for room, done in searches.items()
-                        if cast(ActionResult, done.value).ok)
+                        if cast(ActionResult, done.value).ok and room not in sim.searched)
 
 
 def scheduled(sim: Simulation, event: Any) -> Generator[simpy.Event, Any, None]:
