@@ -288,6 +288,9 @@ def mission_from_args(args: argparse.Namespace) -> tuple[Any, Path]:
     if args.no_recording:
         outputs = mission.spec.outputs.model_copy(update={"recording": False})
         mission = mission.with_changes(outputs=outputs.model_dump())
+    if getattr(args, "manual", False):  # serve and chat
+        assignment = mission.spec.assignment.model_copy(update={"auto": False})
+        mission = mission.with_changes(assignment=assignment.model_dump())
     out = Path(args.out or mission.spec.outputs.dir or Path("out") / mission.name)
     if out.exists() and not out.is_dir():
         raise InputError(f"{out} exists and is not a folder", key="--out")

@@ -38,6 +38,9 @@ def _add_clock_options(parser: argparse.ArgumentParser) -> None:
                        help="simulated seconds per wall second, e.g. 1x (the default) or 10x")
     clock.add_argument("--stepped", action="store_true",
                        help="start paused: time moves only on step requests (or resume)")
+    parser.add_argument("--manual", action="store_true",
+                        help="the team waits for commands: no automatic assignment rounds "
+                        "(assignment.auto: false)")
 
 
 def add_api_parsers(sub: Any, add_mission_options: Callable[[Any], None]) -> None:
