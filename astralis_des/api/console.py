@@ -62,7 +62,7 @@ def _announce(console: Console, record: dict[str, Any], exit_on_end: bool) -> No
     elif kind == "detection":
         console.print(f"t = {record['t']:.1f} s: [bold green]target found[/] by "
                       f"{record['robot']}")
-    elif kind == "command":
+    elif kind == "command" and record.get("op") != "step":  # a stepping client steps a lot
         what = " ".join(str(record[k]) for k in ("robot", "op", "action", "room")
                         if record.get(k) is not None)
         console.print(f"t = {record['t']:.1f} s: command: {what}")
