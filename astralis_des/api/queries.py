@@ -75,13 +75,12 @@ def _status(svc: Service, args: OptionalRobot) -> dict[str, Any]:
     sim = svc.sim
     robots = ([svc.robot(args.robot)] if args.robot is not None
               else list(sim.robots.values()))
-    detection = next(iter(sim.log.of_kind("detection")), None)
     return {
         "t": svc.now, "clock": svc.clock.describe(), "running": svc.clock.running,
         "pace": svc.clock.pace, "ended": svc.ended,
         "outcome": svc.result.outcome if svc.result is not None else None,
         "found": sim.found.triggered,
-        "found_by": detection["robot"] if detection is not None else None,
+        "found_by": sim.found.value if sim.found.triggered else None,  # the finder's id
         "rounds": len(sim.rounds), "rooms_searched": list(sim.searched),
         "robots": {r.id: robot_state(svc, r) for r in robots},
     }
