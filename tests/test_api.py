@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -161,6 +162,7 @@ def test_pause_resume_and_step(client: Client) -> None:
     with pytest.raises(ApiError, match="pause it first") as err:
         client.step(by=1.0)
     assert err.value.code == "clock_running"
+    time.sleep(0.1)  # 5 simulated s at 50x
     paused = client.pause()
     assert paused["clock"] == "paused" and paused["t"] > 2.5  # time ran meanwhile
     ops = [e["op"] for e in client.events(kinds=["command"])["events"]]
