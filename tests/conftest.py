@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
 from astralis_des import Mission, load_mission
 from astralis_des.world.build import load_world
 from astralis_des.world.model import World
+
+if TYPE_CHECKING:
+    from astralis_des.api.client import Client
 
 ROOT = Path(__file__).resolve().parents[1]
 MISSIONS = ROOT / "missions"
@@ -23,3 +28,21 @@ def world() -> World:
 @pytest.fixture(scope="session")
 def urban_search() -> Mission:
     return load_mission(MISSIONS / "urban_search.yaml")
+
+
+@pytest.fixture
+def address(mission: Mission, tmp_path: Path) -> Iterator[str]:
+    """A fresh server of the module's ``mission``, its clock paused: time moves only when a
+    test steps it."""
+    from astralis_des.api.local import serving
+
+    with serving(mission, running=False, out_dir=tmp_path / "out") as address:
+        yield address
+
+
+@pytest.fixture
+def client(address: str) -> Iterator[Client]:
+    from astralis_des.api.client import Client
+
+    with Client(address, timeout=5.0) as client:
+        yield client

@@ -7,7 +7,6 @@ import importlib.util
 import socket
 import subprocess
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -37,19 +36,6 @@ def team(mission: Mission, tmp_path_factory: pytest.TempPathFactory) -> Team:
     with serving(mission, running=False, out_dir=tmp_path_factory.mktemp("info")) as address, \
             Client(address) as client:
         return Team.from_info(client.info())
-
-
-@pytest.fixture
-def address(mission: Mission, tmp_path: Path) -> Iterator[str]:
-    """A fresh server, its clock paused: time moves only when a test steps it."""
-    with serving(mission, running=False, out_dir=tmp_path / "out") as address:
-        yield address
-
-
-@pytest.fixture
-def client(address: str) -> Iterator[Client]:
-    with Client(address, timeout=5.0) as client:
-        yield client
 
 
 @pytest.fixture

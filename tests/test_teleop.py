@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import subprocess
 import termios
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +13,6 @@ from terminal import Terminal, cli, quiet_env
 
 from astralis_des import Mission
 from astralis_des.api.client import Client
-from astralis_des.api.local import serving
 from astralis_des.chat.keys import KeyDecoder
 from astralis_des.chat.teleop import Teleop, drive
 
@@ -31,18 +29,6 @@ def mission(urban_search: Mission) -> Mission:
     return urban_search.with_changes(
         team=team, assignment={**spec.assignment.model_dump(), "auto": False},
         outputs={**spec.outputs.model_dump(), "recording": False})
-
-
-@pytest.fixture
-def address(mission: Mission, tmp_path: Path) -> Iterator[str]:
-    with serving(mission, running=False, out_dir=tmp_path / "out") as address:
-        yield address
-
-
-@pytest.fixture
-def client(address: str) -> Iterator[Client]:
-    with Client(address, timeout=5.0) as client:
-        yield client
 
 
 def position(client: Client, robot: str = "op1") -> np.ndarray:
