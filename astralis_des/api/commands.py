@@ -11,7 +11,7 @@ from pydantic import Field
 
 from astralis_des.actions import ACTIONS, ROOMLESS, actions_for
 from astralis_des.api.ops import Args, NoArgs, op
-from astralis_des.api.protocol import MAX_PACE, ApiError
+from astralis_des.api.protocol import MAX_PACE, MAX_TELEOP_STEP, ApiError
 from astralis_des.errors import InputError, suggest
 from astralis_des.kernel.timeline import book, dispatch
 
@@ -58,7 +58,7 @@ class AssignArgs(Args):
 class TeleopArgs(Args):
     robot: str
     direction: Literal["north", "south", "east", "west"]
-    distance: float = Field(0.5, gt=0.0, le=5.0)
+    distance: float = Field(0.5, gt=0.0, le=MAX_TELEOP_STEP)
 
 
 def _task(svc: Service, args: TaskArgs) -> Robot:

@@ -7,7 +7,7 @@ from typing import Any
 
 from rich.console import Console
 
-EXIT_INTERRUPTED = 130
+from astralis_des.cli import EXIT_INTERRUPTED
 
 
 def serve_command(args: argparse.Namespace) -> int:

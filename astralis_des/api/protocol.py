@@ -18,6 +18,7 @@ MAX_MESSAGE = 64 * 1024  # bytes: a longer request gets an error reply
 HARD_LIMIT = 16 * MAX_MESSAGE  # bytes: ZeroMQ drops a peer that sends more (MAXMSGSIZE)
 MAX_ID = 128  # characters of a request id
 MAX_PACE = 1000.0  # simulated seconds per wall second
+MAX_TELEOP_STEP = 5.0  # m of one teleop step
 
 
 class ApiError(Exception):

@@ -20,12 +20,12 @@ from astralis_des.chat import robots
 from astralis_des.chat.language import Parsed, complete, help_rows, parse
 from astralis_des.chat.show import events_text, queue_text, reply, unwrapped
 from astralis_des.chat.team import ChatError, Team
+from astralis_des.cli import EXIT_INTERRUPTED
 from astralis_des.registry import Registry
 
 if TYPE_CHECKING:
     from astralis_des.api.client import Client
 
-EXIT_INTERRUPTED = 130
 STEP_TIMEOUT = 120.0  # s a step may take: a physics mission runs it before replying
 PROMPT = "astralis> "
 HISTORY = "~/.astralis_history"  # or $ASTRALIS_HISTORY

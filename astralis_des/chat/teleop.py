@@ -19,17 +19,16 @@ from typing import TYPE_CHECKING
 from rich.console import Console
 from rich.text import Text
 
-from astralis_des.api.protocol import ApiError
+from astralis_des.api.protocol import MAX_TELEOP_STEP, ApiError
 from astralis_des.chat.keys import QUIT, KeyDecoder
 from astralis_des.chat.show import where
+from astralis_des.cli import EXIT_INTERRUPTED
 from astralis_des.errors import InputError, suggest
 
 if TYPE_CHECKING:
     from astralis_des.api.client import Client
 
-EXIT_INTERRUPTED = 130
 REFRESH = 0.25  # wall s between status refreshes on a terminal while no key comes
-MAX_STEP = 5.0  # m: the API's limit of a teleop step
 
 
 class Teleop:
@@ -130,8 +129,8 @@ class StatusLine:
 def teleop_command(args: argparse.Namespace) -> int:
     from astralis_des.chat.link import connect
 
-    if not 0.0 < args.step <= MAX_STEP:
-        raise InputError(f"must be above 0 and at most {MAX_STEP:g} m (got {args.step:g})",
+    if not 0.0 < args.step <= MAX_TELEOP_STEP:
+        raise InputError(f"must be above 0 and at most {MAX_TELEOP_STEP:g} m (got {args.step:g})",
                          key="--step")
     client, info = connect(args.connect, args.timeout, args.curve_keys)
     with client:

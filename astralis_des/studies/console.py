@@ -10,6 +10,7 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
+from astralis_des.cli import EXIT_INTERRUPTED
 from astralis_des.errors import InputError
 from astralis_des.studies.backends import make_backend
 from astralis_des.studies.reports import TextTable, report
@@ -17,7 +18,6 @@ from astralis_des.studies.runner import run_scenario, run_study
 from astralis_des.studies.spec import Study, load_study
 
 EXIT_FAILED = 1
-EXIT_INTERRUPTED = 130
 
 
 def study_command(args: argparse.Namespace) -> int:
