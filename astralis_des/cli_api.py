@@ -6,7 +6,7 @@ import argparse
 from collections.abc import Callable
 from typing import Any
 
-from astralis_des.api.protocol import MAX_PACE
+from astralis_des.api.protocol import read_pace
 
 Command = Callable[[argparse.Namespace], int]
 API_COMMANDS: dict[str, Command] = {}
@@ -23,13 +23,9 @@ def command(name: str) -> Callable[[Command], Command]:
 def parse_pace(text: str) -> float:
     """``10``, ``10x`` or ``0.5x``: simulated seconds per wall second."""
     try:
-        pace = float(text.strip().lower().removesuffix("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"'{text}' is not a pace like 1x or 10x") from None
-    if not 0.0 < pace <= MAX_PACE:
-        raise argparse.ArgumentTypeError(f"the pace must be above 0 and at most "
-                                         f"{MAX_PACE:g}x (got {text})")
-    return pace
+        return read_pace(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _add_clock_options(parser: argparse.ArgumentParser) -> None:

@@ -324,3 +324,25 @@ def test_commands_are_in_the_recording(manual: Mission, tmp_path: Path) -> None:
     for line in ("uav1 command enqueue hover", "op1 command teleop north", "command step",
                  "command shutdown"):
         assert line in shown, line
+
+
+def test_events_since_a_time_in_and_out_of_time_order(manual: Mission) -> None:
+    """``since`` skips ahead by bisection while the log is in time order, and still finds every
+    event once a contact stamped inside a macro-step has put it out of order."""
+    from astralis_des import Simulation
+    from astralis_des.api.service import Clock, Service
+
+    service = Service(Simulation(manual), Clock(running=False))
+    log = service.sim.log
+    for t in (1.0, 2.0, 2.0, 3.0):
+        log.emit("probe", at=t, n=t)
+
+    def since(t: float) -> list[float]:
+        reply = service.handle({"op": "events", "since": t, "kinds": ["probe"]})
+        return [e["n"] for e in reply["result"]["events"]]
+
+    assert log.in_order and since(2.0) == [2.0, 2.0, 3.0] and since(3.5) == []
+    log.emit("probe", at=2.5, n=2.5)
+    assert not log.in_order and since(2.0) == [2.0, 2.0, 3.0, 2.5]
+    last = service.handle({"op": "events", "since": 2.2, "last": 2})["result"]["events"]
+    assert [e["n"] for e in last] == [3.0, 2.5]

@@ -21,6 +21,17 @@ MAX_PACE = 1000.0  # simulated seconds per wall second
 MAX_TELEOP_STEP = 5.0  # m of one teleop step
 
 
+def read_pace(text: str) -> float:
+    """``10``, ``10x`` or ``0.5x``: simulated seconds per wall second (ValueError if not)."""
+    try:
+        pace = float(text.strip().lower().removesuffix("x"))
+    except ValueError:
+        raise ValueError(f"'{text}' is not a pace like 1x or 10x") from None
+    if not 0.0 < pace <= MAX_PACE:
+        raise ValueError(f"the pace must be above 0 and at most {MAX_PACE:g}x (got {text})")
+    return pace
+
+
 class ApiError(Exception):
     """A request the server refused, or a failure the client saw: a code and one line."""
 

@@ -3,6 +3,7 @@ queues and events. They change nothing and are never logged."""
 
 from __future__ import annotations
 
+import bisect
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -131,27 +132,37 @@ def _events(svc: Service, args: EventsArgs) -> dict[str, Any]:
     records = svc.sim.log.records
     kinds = set(args.kinds) if args.kinds is not None else None
 
+    start = args.after
+    since = args.since
+    if since is not None and svc.sim.log.in_order:  # skip to ``since`` at once
+        start = max(start, bisect.bisect_left(records, since, key=_time))
+        since = None
+
     def wanted(rec: dict[str, Any]) -> bool:
-        return ((args.since is None or rec["t"] >= args.since)
+        return ((since is None or rec["t"] >= since)
                 and (kinds is None or rec["kind"] in kinds)
                 and (args.robot is None or rec.get("robot") == args.robot))
 
     out: list[dict[str, Any]] = []
     if args.last is not None:  # from the end backwards, then in order
         index = len(records)
-        for back in range(len(records) - 1, args.after - 1, -1):
+        for back in range(len(records) - 1, start - 1, -1):
             if wanted(records[back]):
                 out.append(records[back])
                 if len(out) == args.last:
                     break
         return {"events": out[::-1], "next": index, "total": index, "t": svc.now}
-    index = args.after
+    index = start
     while index < len(records) and len(out) < args.limit:
         rec = records[index]
         index += 1
         if wanted(rec):
             out.append(rec)
     return {"events": out, "next": index, "total": len(records), "t": svc.now}
+
+
+def _time(rec: dict[str, Any]) -> float:
+    return float(rec["t"])
 
 
 # -- shared with the state stream ----------------------------------------------------------

@@ -101,9 +101,9 @@ class Service:
             key = (peer, request_id) if request_id is not None else None
             if key is not None and key in self._replies:  # a client's retry of a command
                 return self._replies[key]
-            reply = self.handle(request)
+            reply, command = self._answer(request)
             data = encode(reply)
-            if key is not None and reply["ok"] and OPS.get(request["op"]).command:
+            if key is not None and reply["ok"] and command:
                 self._replies[key] = data
                 if len(self._replies) > REPLAYS:
                     self._replies.popitem(last=False)
@@ -118,6 +118,11 @@ class Service:
 
     def handle(self, request: dict[str, Any]) -> dict[str, Any]:
         """A decoded request to its reply (``ok`` true or false)."""
+        return self._answer(request)[0]
+
+    def _answer(self, request: dict[str, Any]) -> tuple[dict[str, Any], bool]:
+        """The reply, and whether the request was a command that ran (its reply is kept
+        for retries)."""
         self.requests += 1
         request_id = request.get("id")
         try:
@@ -133,8 +138,8 @@ class Service:
             result = spec.fn(self, args)
         except ApiError as exc:
             self.errors += 1
-            return exc.reply(request_id)
-        return {"id": request_id, "ok": True, "result": finite(result)}
+            return exc.reply(request_id), False
+        return {"id": request_id, "ok": True, "result": finite(result)}, spec.command
 
     # -- what requests name ----------------------------------------------------------------
     def robot(self, robot_id: str) -> Robot:

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from astralis_des.api.protocol import read_pace
 from astralis_des.chat import robots
 from astralis_des.chat.team import ChatError, Team, number, seconds
 from astralis_des.errors import suggest
@@ -233,9 +234,10 @@ def _resume(words: list[str], team: Team) -> Parsed:
     _at_most(words, 1, "resume [PACE]")
     if not words:
         return Parsed("resume")
-    pace = number(words[0].lower().removesuffix("x"))
-    if pace is None or pace <= 0:
-        raise ChatError(f"resume: '{words[0]}' is not a pace like 1x or 10x")
+    try:
+        pace = read_pace(words[0])
+    except ValueError as exc:
+        raise ChatError(f"resume: {exc}") from None
     return Parsed("resume", {"pace": pace})
 
 

@@ -25,6 +25,7 @@ class EventLog:
         self.env = env
         self.records: list[Record] = []
         self.sinks: list[Sink] = []
+        self.in_order = True  # every record's time at or after the one before
 
     def emit(self, kind: str, robot: str | None = None, *, at: float | None = None,
              **payload: Any) -> Record:
@@ -35,6 +36,8 @@ class EventLog:
         if robot is not None:
             record["robot"] = robot
         record.update({k: plain(v) for k, v in payload.items()})
+        if self.records and record["t"] < self.records[-1]["t"]:
+            self.in_order = False
         self.records.append(record)
         for sink in self.sinks:
             sink(record)
