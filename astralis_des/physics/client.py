@@ -10,6 +10,7 @@ import numpy as np
 import pybullet as pb
 import pybullet_data
 
+from astralis_des.physics.planar import BoxIndex
 from astralis_des.physics.quiet import quiet_c_output
 from astralis_des.world.model import BLOCK, World
 
@@ -41,6 +42,7 @@ class PhysicsClient:
                   deterministicOverlappingPairs=1)
         plane = self.call("createCollisionShape", pb.GEOM_PLANE)
         self.ground = self.call("createMultiBody", 0, plane)
+        self.boxes = BoxIndex()  # every box of ``add_boxes``, for the lidar's planar rays
         self.static = self._add_static(world)
 
     def call(self, name: str, *args: Any, **kwargs: Any) -> Any:
@@ -90,7 +92,8 @@ class PhysicsClient:
         """Static compound bodies of axis-aligned boxes given by their corners.
 
         PyBullet keeps at most 16 shapes of one ``createCollisionShapeArray`` call and drops
-        the rest without a word, so the boxes go in compounds of ``COMPOUND`` at most.
+        the rest without a word, so the boxes go in compounds of ``COMPOUND`` at most. They
+        are in ``boxes`` too, for the lidar.
         """
         lo, hi = np.asarray(los, dtype=float), np.asarray(his, dtype=float)
         bodies = []
@@ -99,7 +102,9 @@ class PhysicsClient:
             shape = self.call("createCollisionShapeArray", [pb.GEOM_BOX] * len(a),
                               halfExtents=((b - a) / 2).tolist(),
                               collisionFramePositions=((b + a) / 2).tolist())
-            bodies.append(int(self.call("createMultiBody", 0, shape)))
+            body = int(self.call("createMultiBody", 0, shape))
+            self.boxes.add(a, b, body)
+            bodies.append(body)
         return bodies
 
     def add_box(self, centre: Any, size: Any) -> int:

@@ -20,6 +20,7 @@ import pybullet as pb
 from numpy.typing import NDArray
 
 from astralis_des.physics.client import GRAVITY, PhysicsClient
+from astralis_des.physics.planar import beams_near_bodies
 from astralis_des.world.geometry import FloatArray
 
 __all__ = ["Camera", "Frame", "Imu", "ImuReading", "Intrinsics", "Lidar2D", "Scan"]
@@ -230,23 +231,27 @@ class Lidar2D:
     def scan(self, time: float = 0.0) -> Scan:
         """Cast every beam and add range noise to the returns.
 
-        Two passes of ``rayTestBatch``: every beam to ``near`` metres, then the beams that
-        found nothing on from there. A ray's cost grows with the bounding boxes it crosses, so
-        indoors, where most beams end on a wall within a few metres, this costs about a third
-        less than full-length rays (measured in building A; the closest hit is the same)."""
+        The static boxes (walls, slabs, obstacles, furniture) are a 2-D slab test in numpy
+        (:mod:`astralis_des.physics.planar`). Bullet's ``rayTestBatch`` then follows only the
+        beams that cross another body's bounding box (robots, avatars, the target, imported
+        meshes), each only as far as its box (a box it meets there is the same hit). In two
+        passes: to ``near`` metres, then on from there for the beams that found nothing; a
+        ray's cost grows with the bounding boxes it crosses."""
         centre, directions = self._frame()
-        near = min(max(self.near, self.start_offset), self.range_max)
-        starts = centre + self.start_offset * directions
-        middle = centre + near * directions
-        hits = self.client.call("rayTestBatch", starts.tolist(), middle.tolist())
-        ids = np.array([h[0] for h in hits], dtype=np.int32)
-        ranges = self.start_offset + np.array([h[2] for h in hits]) * (near - self.start_offset)
-        beyond = np.flatnonzero(ids < 0)
-        if len(beyond) and near < self.range_max:
-            ends = centre + self.range_max * directions[beyond]
-            more = self.client.call("rayTestBatch", middle[beyond].tolist(), ends.tolist())
-            ids[beyond] = [h[0] for h in more]
-            ranges[beyond] = near + np.array([h[2] for h in more]) * (self.range_max - near)
+        start = self.start_offset
+        ranges, ids = self.client.boxes.cast(centre, directions, start, self.range_max)
+        ranges = np.minimum(ranges, self.range_max)  # a beam's reach: to its box or its end
+        beams = beams_near_bodies(self.client, centre, directions, start, ranges)
+        if len(beams):
+            reach, along = ranges[beams], directions[beams]
+            first = np.minimum(max(self.near, start), reach)
+            found, at = self._cast(centre, along, start, first)
+            beyond = np.flatnonzero((found < 0) & (first < reach))
+            if len(beyond):
+                found[beyond], at[beyond] = self._cast(centre, along[beyond], first[beyond],
+                                                       reach[beyond])
+            hit = found >= 0
+            ranges[beams[hit]], ids[beams[hit]] = at[hit], found[hit]
         if self.noise_std > 0 and self.rng is not None:
             # drawn for every beam, so that the stream does not depend on what was hit
             ranges = ranges + self.rng.normal(0.0, self.noise_std, len(ranges))
@@ -255,6 +260,16 @@ class Lidar2D:
         ids[missed] = NO_BODY
         points = centre + np.where(missed, np.nan, ranges)[:, None] * directions
         return Scan(ranges, self.angles.copy(), points, ids, time)
+
+    def _cast(self, centre: FloatArray, directions: FloatArray, near: float | FloatArray,
+              far: FloatArray) -> tuple[IntArray, FloatArray]:
+        """Bullet's hits along the beams from ``near`` to ``far`` metres: the bodies hit (-1 for
+        none) and their distances."""
+        hits = self.client.call("rayTestBatch",
+                                (centre + np.reshape(near, (-1, 1)) * directions).tolist(),
+                                (centre + far[:, None] * directions).tolist())
+        found = np.array([h[0] for h in hits], dtype=np.int32)
+        return found, near + np.array([h[2] for h in hits]) * (far - near)
 
 
 @dataclass
