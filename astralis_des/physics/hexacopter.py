@@ -144,12 +144,16 @@ class Hexacopter:
 
     def _rotors(self, wrench: tuple[float, float, float, float], pos: Vec,
                 rot: tuple[float, ...]) -> None:
-        """Mix (thrust, torques) to rotor thrusts through the motors' lag; apply them."""
-        kf, km, cid, body = self.spec.thrust_constant, self.spec.moment_constant, \
-            self.client.id, self.body
+        """Mix (thrust, torques) to rotor thrusts through the motors' lag; apply them.
+
+        Each rotor pushes along the body's z at its arm's end; applied as their sum at the
+        centre of mass and the sum of their moments about it plus the rotors' drag torque
+        (what PyBullet makes of a force at a point: two calls instead of seven)."""
+        kf, km = self.spec.thrust_constant, self.spec.moment_constant
         r00, r01, r02, r10, r11, r12, r20, r21, r22 = rot
         ux, uy, uz = r02, r12, r22
-        drag = 0.0
+        drag = total = 0.0
+        mx = my = mz = 0.0  # sum of thrust x the arm's end, relative to the centre of mass
         for i, (mix, (ox, oy), spin) in enumerate(self._geometry):
             wanted = min(max(mix[0] * wrench[0] + mix[1] * wrench[1] + mix[2] * wrench[2]
                              + mix[3] * wrench[3], 0.0), self.max_thrust)
@@ -158,10 +162,14 @@ class Hexacopter:
             self.rotor_speed[i] = speed
             f = kf * speed * speed
             drag += spin * f
-            where = (pos[0] + r00 * ox + r01 * oy, pos[1] + r10 * ox + r11 * oy,
-                     pos[2] + r20 * ox + r21 * oy)
-            pb.applyExternalForce(body, -1, (ux * f, uy * f, uz * f), where, pb.WORLD_FRAME,
-                                  physicsClientId=cid)
+            total += f
+            mx += f * (r00 * ox + r01 * oy)
+            my += f * (r10 * ox + r11 * oy)
+            mz += f * (r20 * ox + r21 * oy)
         drag *= km
-        pb.applyExternalTorque(body, -1, (ux * drag, uy * drag, uz * drag), pb.WORLD_FRAME,
-                               physicsClientId=cid)
+        torque = (my * uz - mz * uy + ux * drag, mz * ux - mx * uz + uy * drag,
+                  mx * uy - my * ux + uz * drag)
+        cid, body = self.client.id, self.body
+        pb.applyExternalForce(body, -1, (ux * total, uy * total, uz * total), tuple(pos),
+                              pb.WORLD_FRAME, physicsClientId=cid)
+        pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, physicsClientId=cid)

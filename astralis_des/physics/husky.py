@@ -7,6 +7,7 @@ turns the path into a speed and a curvature, and those into wheel speeds (skid s
 
 from __future__ import annotations
 
+import bisect
 import math
 
 import numpy as np
@@ -41,6 +42,8 @@ class Husky:
         self.wheels = self.left + self.right
         self.path: FloatArray = np.zeros((0, 2))
         self.cum: FloatArray = np.zeros(1)
+        self._points: list[list[float]] = []
+        self._lengths: list[float] = [0.0]
         self.progress = 0.0
         self.speed = 1.0
         self.limit = math.inf  # m/s: a cap the local planner sets (obstacles ahead)
@@ -76,24 +79,26 @@ class Husky:
         self.path = np.asarray(path, dtype=float)[:, :2]
         seg = np.linalg.norm(np.diff(self.path, axis=0), axis=1)
         self.cum = np.concatenate([[0.0], np.cumsum(seg)])
+        self._points, self._lengths = self.path.tolist(), self.cum.tolist()  # plain floats
         self.progress = 0.0  # arc length of the robot's projection on the path, never back
         self.speed = speed
 
     def _project(self, x: float, y: float) -> float:
         """Arc length of the closest point of the path ahead of the current progress."""
         best_s, best_d = self.progress, math.inf
-        first = max(int(np.searchsorted(self.cum, self.progress, side="right")) - 1, 0)
-        for i in range(first, len(self.path) - 1):
-            a, b = self.path[i], self.path[i + 1]
-            length = self.cum[i + 1] - self.cum[i]
+        points, cum = self._points, self._lengths
+        first = max(bisect.bisect_right(cum, self.progress) - 1, 0)
+        for i in range(first, len(points) - 1):
+            a, b = points[i], points[i + 1]
+            length = cum[i + 1] - cum[i]
             if length < 1e-9:
                 continue
             u = min(max(((x - a[0]) * (b[0] - a[0]) + (y - a[1]) * (b[1] - a[1]))
                         / (length * length), 0.0), 1.0)
             d = math.hypot(a[0] + u * (b[0] - a[0]) - x, a[1] + u * (b[1] - a[1]) - y)
             if d < best_d - 1e-9:
-                best_s, best_d = self.cum[i] + u * length, d
-            if self.cum[i] > self.progress + 2 * LOOKAHEAD:
+                best_s, best_d = cum[i] + u * length, d
+            if cum[i] > self.progress + 2 * LOOKAHEAD:
                 break
         return max(best_s, self.progress)
 
