@@ -3,21 +3,29 @@
 from __future__ import annotations
 
 import argparse
+import importlib
 from collections.abc import Callable
 from typing import Any
 
 from astralis_des.api.protocol import read_pace
 
 Command = Callable[[argparse.Namespace], int]
-API_COMMANDS: dict[str, Command] = {}
 
 
-def command(name: str) -> Callable[[Command], Command]:
-    def add(fn: Command) -> Command:
-        API_COMMANDS[name] = fn
-        return fn
+def _lazy(module: str, function: str) -> Command:
+    """A command whose module is imported only when it runs: ``astralis --help`` stays quick."""
+    def run(args: argparse.Namespace) -> int:
+        return int(getattr(importlib.import_module(module), function)(args))
 
-    return add
+    return run
+
+
+API_COMMANDS: dict[str, Command] = {
+    "serve": _lazy("astralis_des.api.console", "serve_command"),
+    "keys": _lazy("astralis_des.api.console", "keys_command"),
+    "chat": _lazy("astralis_des.chat.repl", "chat_command"),
+    "teleop": _lazy("astralis_des.chat.teleop", "teleop_command"),
+}
 
 
 def parse_pace(text: str) -> float:
@@ -82,31 +90,3 @@ def add_api_parsers(sub: Any, add_mission_options: Callable[[Any], None]) -> Non
     teleop.add_argument("--step", type=float, default=0.5, metavar="M",
                         help="metres a key press moves (default 0.5)")
     teleop.add_argument("--timeout", type=float, default=2.0, help="s to wait for a reply")
-
-
-@command("serve")
-def _serve(args: argparse.Namespace) -> int:
-    from astralis_des.api.console import serve_command
-
-    return serve_command(args)
-
-
-@command("keys")
-def _keys(args: argparse.Namespace) -> int:
-    from astralis_des.api.console import keys_command
-
-    return keys_command(args)
-
-
-@command("chat")
-def _chat(args: argparse.Namespace) -> int:
-    from astralis_des.chat.repl import chat_command
-
-    return chat_command(args)
-
-
-@command("teleop")
-def _teleop(args: argparse.Namespace) -> int:
-    from astralis_des.chat.teleop import teleop_command
-
-    return teleop_command(args)

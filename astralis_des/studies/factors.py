@@ -131,40 +131,23 @@ def _team(s: Setting, value: TeamMix) -> Setting:
     return replace(s, team=value.model_dump())
 
 
-@factor("risk", Dist)
-def _risk(s: Setting, value: Any) -> Setting:
-    """the distribution of each room's risk"""
-    return replace(s, risk=value)
+def _sets(field: str) -> Callable[[Setting, Any], Setting]:
+    """Apply a value by setting the field of the same name."""
+    def apply(s: Setting, value: Any) -> Setting:
+        return replace(s, **{field: value})
+
+    return apply
 
 
-@factor("messiness", Dist)
-def _messiness(s: Setting, value: Any) -> Setting:
-    """the distribution of each room's messiness"""
-    return replace(s, messiness=value)
-
-
-@factor("fidelity", Literal["kinematic", "physics"], only="mission")
-def _fidelity(s: Setting, value: str) -> Setting:
-    """kinematic or physics"""
-    return replace(s, fidelity=value)
-
-
-@factor("time_limit", PositiveFloat, only="mission")
-def _time_limit(s: Setting, value: float) -> Setting:
-    """the mission's time limit, s"""
-    return replace(s, time_limit=value)
-
-
-@factor("high_risk", Unit)
-def _high_risk(s: Setting, value: float) -> Setting:
-    """risk from which a room is high-risk (the paper: 0.5)"""
-    return replace(s, high_risk=value)
-
-
-@factor("high_messiness", Unit)
-def _high_messiness(s: Setting, value: float) -> Setting:
-    """messiness from which a room is high-messiness (the paper: 0.5)"""
-    return replace(s, high_messiness=value)
+for _name, _type, _only, _help in (
+        ("risk", Dist, None, "the distribution of each room's risk"),
+        ("messiness", Dist, None, "the distribution of each room's messiness"),
+        ("fidelity", Literal["kinematic", "physics"], "mission", "kinematic or physics"),
+        ("time_limit", PositiveFloat, "mission", "the mission's time limit, s"),
+        ("high_risk", Unit, None, "risk from which a room is high-risk (the paper: 0.5)"),
+        ("high_messiness", Unit, None,
+         "messiness from which a room is high-messiness (the paper: 0.5)")):
+    factor(_name, _type, only=_only, help=_help)(_sets(_name))
 
 
 def base_setting(mission: Any, risk: Any = None, messiness: Any = None) -> Setting:
