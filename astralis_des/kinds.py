@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 
@@ -25,6 +26,14 @@ class KindDefaults:
     sensors: tuple[str, ...]  # what it carries when the mission names no sensors
     accel: float | None = None  # m/s^2 speeding up and slowing down; None for a walker
     turn_rate: float | None = None  # rad/s turning on the spot (a non-holonomic robot)
+    footprint: tuple[float, float] | None = None  # m, length and width of a long body
+
+    @property
+    def swept_radius(self) -> float | None:
+        """The circle a body with a footprint sweeps turning on the spot (its half-diagonal)."""
+        if self.footprint is None:
+            return None
+        return math.hypot(self.footprint[0] / 2, self.footprint[1] / 2)
 
 
 KIND_DEFAULTS: dict[str, KindDefaults] = {
@@ -35,7 +44,7 @@ KIND_DEFAULTS: dict[str, KindDefaults] = {
     # A forward camera on the body, and a lidar the local planner slows down for.
     "ugv": KindDefaults(speed=1.0, camera=CameraDefaults(6.0, 60.0, 0.0, False, False),
                         height=0.5, distance="manhattan", sensors=("camera", "lidar", "imu"),
-                        accel=1.0, turn_rate=1.0),
+                        accel=1.0, turn_rate=1.0, footprint=(1.01, 0.69)),  # the Husky
     # A person's eyes: a wide view a little down, ahead of where they walk.
     "human": KindDefaults(speed=1.2, camera=CameraDefaults(3.0, 90.0, 15.0, True, True),
                           height=1.6, distance="manhattan", sensors=("camera",)),

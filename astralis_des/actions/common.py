@@ -10,12 +10,14 @@ import simpy
 
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kernel.tasks import ActionResult, Task, TaskStatus
-from astralis_des.kinds import TARGET_HEIGHT
+from astralis_des.kinds import KIND_DEFAULTS, TARGET_HEIGHT
 from astralis_des.planning.navigator import Navigator, Route
 from astralis_des.sensing import GeometricSensor, Sighting
 from astralis_des.world.geometry import FloatArray
 from astralis_des.world.model import Room, World
 
+DOOR_OFFSET = 0.6  # m in front of a door's wall: where robots stop by a door
+TURN_MARGIN = 0.1  # m kept between a wall and the circle a body sweeps turning on the spot
 ActionGen = Generator[simpy.Event, Any, ActionResult]
 StepGen = Generator[simpy.Event, Any, float]
 
@@ -31,7 +33,12 @@ class CoSim(Protocol):
 
 
 class MotionFailed(Exception):
-    """A motion ended without arriving; the action ends ``failed`` with this reason."""
+    """A motion ended without arriving; the action ends ``failed`` with this reason. With
+    ``fault`` the robot cannot go on (it crashed): it is faulted and leaves the mission."""
+
+    def __init__(self, reason: str, fault: bool = False) -> None:
+        super().__init__(reason)
+        self.fault = fault
 
 
 class Context(Protocol):
@@ -86,7 +93,7 @@ def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> Ste
     outcome = yield done
     ctx.cosim.halt(robot)
     if not outcome.ok:
-        raise MotionFailed(outcome.reason)
+        raise MotionFailed(outcome.reason, outcome.fault)
     return robot.distance - before
 
 
@@ -111,23 +118,32 @@ def go_to(ctx: Context, robot: Robot, goal_floor: tuple[float, ...],
 
 def search_path(ctx: Context, robot: Robot, room: Room, plan: FloatArray, label: str) -> ActionGen:
     """Go to the start of a coverage path ``plan`` (floor level) and follow it, sensing."""
-    sweep = at_height(robot, plan)
-    coverage = ctx.sensor.coverage(robot, sweep, room)  # furnishes the room before going in
-    sweep = ctx.navigator.usable(robot, sweep)  # where the body fits among the furniture
+    ctx.sensor.scene.clutter(room.id)  # the room is furnished before the robot goes in
+    pattern = at_height(robot, plan)
+    sweep = ctx.navigator.usable(robot, pattern)  # where the body fits among the furniture
     if len(sweep) == 0:
         return failed(f"{label}: no point of the pattern is free in {room.id}")
     approach = route(ctx, robot, sweep[0] - np.array([0.0, 0.0, robot.height]))
     if approach.points is None:
         return failed(approach.reason)
     distance = yield from traverse(ctx, robot, approach.points, sense=False)
-    refined = ctx.navigator.refine(robot, sweep) if ctx.navigator.method == "map" else None
-    if refined is not None:
-        if refined.points is None:
-            return failed(refined.reason)
-        sweep = refined.points
+    skipped = len(pattern) - len(sweep)
+    if ctx.navigator.method == "map":  # unreachable points are left out, not the search
+        refined = ctx.navigator.refine(robot, sweep, skip=True)
+        assert refined.points is not None
+        sweep, skipped = refined.points, skipped + refined.skipped
+    coverage = ctx.sensor.coverage(robot, sweep, room)
+    note = f" ({skipped} of {len(pattern)} points out of reach)" if skipped else ""
     distance += yield from traverse(ctx, robot, sweep, sense=True)
-    return result(TaskStatus.SUCCEEDED, f"{label} saw {coverage:.0%} of {room.id}",
-                  distance=distance, coverage=coverage)
+    return result(TaskStatus.SUCCEEDED, f"{label} saw {coverage:.0%} of {room.id}{note}",
+                  distance=distance, coverage=coverage, extra={"skipped": skipped})
+
+
+def stand_off(robot: Robot, least: float = DOOR_OFFSET) -> float:
+    """How far from a wall's face the robot stops to be able to turn on the spot there: a
+    long body (the UGV) needs its half-diagonal and a margin, others ``least``."""
+    swept = KIND_DEFAULTS[robot.kind].swept_radius
+    return least if swept is None else max(least, swept + TURN_MARGIN)
 
 
 def footprint_spacing(robot: Robot, overlap: float) -> float:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from astralis_des.actions import ACTIONS
-from astralis_des.actions.common import ActionGen, Context, failed, go_to, room_of
+from astralis_des.actions.common import ActionGen, Context, failed, go_to, room_of, stand_off
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task
 from astralis_des.kinds import KINDS
@@ -16,7 +16,8 @@ def move(ctx: Context, robot: Robot, task: Task) -> ActionGen:
     if room is not None:
         ctx.sensor.scene.clutter(room.id)  # its furniture is there before the robot is
         where = task.param("point", "center")
-        goal = room.center if where == "center" else room.door_point("corridor")
+        goal = room.center if where == "center" else room.door_point("corridor",
+                                                                     stand_off(robot))
     elif all(k in dict(task.params) for k in ("x", "y")):
         goal = (float(task.param("x", 0)), float(task.param("y", 0)), float(task.param("z", 0)))
     else:

@@ -13,18 +13,20 @@ from astralis_des.actions import ACTIONS
 from astralis_des.actions.common import (
     ActionGen,
     Context,
+    MotionFailed,
     dwell,
     failed,
     result,
     room_of,
     route,
+    stand_off,
     traverse,
 )
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task, TaskStatus
 from astralis_des.world.model import Room
 
-SNEAK_OFFSET = 0.5  # m in front of the wall's face: where the UGV's body clears the jambs
+SNEAK_OFFSET = 0.5  # m in front of the wall's face at least (more for a body that must turn)
 
 
 @ACTIONS.register(("ugv", "sneak_peek"))
@@ -71,13 +73,15 @@ def _peek(ctx: Context, robot: Robot, room: Room,
           seconds: float) -> Generator[simpy.Event, Any, tuple[float, float] | str]:
     """Drive to ``room``'s door, looking ahead; turn into the room and look for ``seconds``.
     Returns the distance driven and the share of the room seen, or why it failed."""
-    way = route(ctx, robot, room.door_point("corridor", offset=SNEAK_OFFSET))
+    way = route(ctx, robot, room.door_point("corridor", offset=stand_off(robot, SNEAK_OFFSET)))
     if way.points is None:
         return way.reason
     distance = yield from traverse(ctx, robot, way.points, sense=True)
     here = robot.position(ctx.env.now)
     into = math.atan2(room.center[1] - here[1], room.center[0] - here[0])
-    yield ctx.cosim.face(robot, into)  # turn the camera into the room
+    turned = yield ctx.cosim.face(robot, into)  # turn the camera into the room
+    if not turned.ok:
+        raise MotionFailed(turned.reason, turned.fault)
     coverage = ctx.sensor.coverage(robot, here[None, :], room, headings=np.array([into]))
     yield from dwell(ctx, robot, seconds)
     return distance, coverage

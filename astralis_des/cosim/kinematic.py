@@ -18,10 +18,12 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class MotionOutcome:
-    """How a motion ended: arrived, or failed with a reason (stuck, left the world, ...)."""
+    """How a motion ended: arrived, or failed with a reason (stuck, left the world, ...).
+    ``fault``: the robot cannot go on (it crashed, fell): it leaves the mission."""
 
     ok: bool
     reason: str
+    fault: bool = False
 
 
 ARRIVED = MotionOutcome(True, "arrived")
@@ -61,6 +63,9 @@ class KinematicCoSim:
 
     def halt(self, robot: Robot) -> None:
         robot.halt(self.env.now)
+
+    def recover(self, robot: Robot) -> None:
+        """A faulted robot is put back in service (nothing to do without a body)."""
 
     def close(self) -> None:
         """Nothing to release; the physics fidelity frees its client here."""

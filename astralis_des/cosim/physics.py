@@ -28,9 +28,11 @@ from astralis_des.kernel.scene import Mover
 from astralis_des.physics.client import PhysicsClient
 from astralis_des.physics.drivers import DRIVERS, Driver
 from astralis_des.physics.hexacopter import write_urdf
+from astralis_des.physics.lift import Lift, lifts_of
 from astralis_des.physics.local import RATE as LOCAL_RATE
 from astralis_des.physics.local import LocalLayer
 from astralis_des.physics.perception import Perception
+from astralis_des.physics.ugv_driver import UgvDriver
 from astralis_des.sensing import GeometricSensor, Sighting
 from astralis_des.world.clutter import Clutter
 from astralis_des.world.geometry import FloatArray
@@ -39,8 +41,10 @@ if TYPE_CHECKING:
     from astralis_des.kernel.simulation import Simulation
 
 CONTACT_CHECKS_PER_S = 30
-PROGRESS = 0.1  # m a moving robot must cover within stuck_timeout
+PROGRESS = 0.1  # m of its path a moving robot must make good within stuck_timeout
 SUPPORT = 0.7  # a contact normal steeper than this holds a ground robot up: not a collision
+CAP_FACTOR, CAP_SLACK = 2.0, 30.0  # a motion planned to take T s fails after 2 T + 30 s
+TURN_CAP = 30.0  # s: a turn on the spot that takes longer has failed
 
 
 @dataclass
@@ -50,10 +54,11 @@ class Track:
 
     driver: Driver
     t0: float
+    cap: float  # s: the motion fails if it takes longer
     times: list[float] = field(default_factory=list)
     points: list[FloatArray] = field(default_factory=list)
     odometry: float = 0.0
-    checkpoint: tuple[float, FloatArray] | None = None
+    best: tuple[float, float] = (0.0, 0.0)  # the most progress made (m), and when
 
     def sample(self, t: float) -> FloatArray:
         here = self.driver.position()
@@ -79,6 +84,7 @@ class PhysicsCoSim:
     def __init__(self, sim: Simulation) -> None:
         spec = sim.mission.spec.physics
         self.env, self.log, self.spec = sim.env, sim.log, spec
+        self.world = sim.world
         self.period = 1.0 / spec.control_rate
         self.client = PhysicsClient(sim.world, spec.dt, spec.rate // spec.control_rate,
                                     spec.solver_iterations)
@@ -90,6 +96,12 @@ class PhysicsCoSim:
         self.names = {d.body: rid for rid, d in self.drivers.items()}
         self.names.update(dict.fromkeys(self.client.static, "wall"))
         self.names[self.client.ground] = "ground"
+        self.lifts = lifts_of(sim.world, self.client)
+        self.names.update({lift.body: "lift" for lift in self.lifts})
+        for driver in self.drivers.values():
+            if isinstance(driver, UgvDriver):
+                driver.lifts = self.lifts
+                driver.column_busy = self._column_busy
         self._scene = sim.scene
         self.robots = sim.robots
         self._navigator = sim.navigator
@@ -148,9 +160,18 @@ class PhysicsCoSim:
             self.movers.append((mover, body))
             self.names[body] = mover.kind
 
+    def _column_busy(self, lift: Lift, rider: str) -> bool:
+        """Is another robot in the lift's column (on any floor: the lift waits for it)?"""
+        return any(rid != rider and lift.contains(driver.position(), 0.35)
+                   for rid, driver in self.drivers.items())
+
     def clearance(self, points: FloatArray) -> FloatArray:
         """Distance to the nearest wall or slab (the navigator's map)."""
         return np.asarray(self._navigator.map.clearance(points))
+
+    def fits(self, rid: str, points: FloatArray) -> np.ndarray:
+        """Where (at its pose height) the robot's body is clear of walls and furniture."""
+        return self._navigator.fits(self.robots[rid], points)
 
     def _move_movers(self) -> None:
         """Put the movers near a moving robot where they are at the end of the coming tick.
@@ -168,7 +189,7 @@ class PhysicsCoSim:
         self.halt(robot)
         motion.t0 = self.env.now
         self.drivers[robot.id].start(motion, self.env.now)
-        return self._activate(robot)
+        return self._activate(robot, CAP_FACTOR * motion.duration + CAP_SLACK)
 
     def face(self, robot: Robot, heading: float) -> simpy.Event:
         """Turn on the spot to ``heading``: the UGV turns its body; others look at once."""
@@ -178,13 +199,13 @@ class PhysicsCoSim:
         if not hasattr(driver, "turn_to"):
             return self.env.timeout(0.0, value=MotionOutcome(True, "arrived"))
         driver.turn_to(heading)
-        return self._activate(robot)
+        return self._activate(robot, TURN_CAP)
 
-    def _activate(self, robot: Robot) -> simpy.Event:
+    def _activate(self, robot: Robot, cap: float) -> simpy.Event:
         """Hand a started driver to the stepper; the event fires when its motion ends."""
-        track = Track(self.drivers[robot.id], self.env.now)
+        track = Track(self.drivers[robot.id], self.env.now, cap)
         track.sample(self.env.now)
-        track.checkpoint = (self.env.now, track.points[-1])
+        track.best = (track.driver.progress(), self.env.now)
         robot.begin(track, self.env.now)  # type: ignore[arg-type]
         done = self.env.event()
         self.active[robot.id] = (robot, track, done)
@@ -210,6 +231,14 @@ class PhysicsCoSim:
     def look(self, robot: Robot, sensor: GeometricSensor) -> Sighting | None:
         """Render what the robot's camera sees from where it waits (around, if it pans)."""
         return self.perception.look(robot)
+
+    def recover(self, robot: Robot) -> None:
+        """A faulted robot back in service: set upright where it lies, on the floor below."""
+        self.halt(robot)
+        here = self.drivers[robot.id].position()
+        floor = self.world.on_floor(here)
+        self.drivers[robot.id].recover(floor)
+        robot.pose = self.drivers[robot.id].position()
 
     def close(self) -> None:
         self.client.close()
@@ -277,12 +306,16 @@ class PhysicsCoSim:
         if not (-5.0 <= here[0] <= self.site[0] + 5.0 and -5.0 <= here[1] <= self.site[1] + 5.0
                 and -1.0 <= here[2] <= 200.0):
             return MotionOutcome(False, "left the world")
-        since, where = track.checkpoint or (self.t, here)
-        if float(np.linalg.norm(here - where)) > PROGRESS or getattr(track.driver, "turning",
-                                                                     False):
-            track.checkpoint = (self.t, here)
-        elif self.t - since > self.spec.stuck_timeout:
+        crash = track.driver.crashed()
+        if crash is not None:
+            return MotionOutcome(False, crash, fault=True)
+        progress = track.driver.progress()
+        if progress > track.best[0] + PROGRESS:
+            track.best = (progress, self.t)
+        elif self.t - track.best[1] > self.spec.stuck_timeout:
             return MotionOutcome(False, f"stuck: no progress for {self.spec.stuck_timeout:g} s")
+        if self.t - track.t0 > track.cap:
+            return MotionOutcome(False, f"timed out: not there after {track.cap:.0f} s")
         return None
 
     def _finish(self, rid: str, outcome: MotionOutcome) -> None:

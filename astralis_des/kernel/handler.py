@@ -85,8 +85,10 @@ class TaskHandler:
         return done
 
     def stop_current(self, cause: Stop) -> None:
-        if self._active is not None and self._active.is_alive:
-            self._active.interrupt(cause)
+        """Interrupt the running task; not when it is the one asking (it ends by itself)."""
+        active = self._active
+        if active is not None and active.is_alive and active is not self.env.active_process:
+            active.interrupt(cause)
 
     def _drop(self, task: Task, status: TaskStatus, reason: str) -> None:
         """End a task that has not started: take it out of the queue, or skip it if taken."""

@@ -52,6 +52,8 @@ class Profile:
         """Time at which each arc length in ``s`` is first reached."""
         s = np.asarray(s, dtype=float)
         moving = np.flatnonzero((self.v > 0) | (self.a > 0))
+        if len(moving) == 0:  # a path of no length (or a turn on the spot): there at once
+            return np.zeros_like(s)
         starts = self.s[moving]
         j = moving[np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(moving) - 1)]
         ds = np.maximum(s - self.s[j], 0.0)

@@ -130,6 +130,8 @@ class Simulation:
             self.cosim.halt(robot)
             outcome = ActionResult(TaskStatus.FAILED, str(failure),
                                    distance=robot.distance - travelled)
+            if failure.fault:
+                self.fault(robot, str(failure))
         except simpy.Interrupt as stop:
             cause = stop.cause if isinstance(stop.cause, Stop) else Stop(
                 TaskStatus.CANCELLED, str(stop.cause))
@@ -155,6 +157,21 @@ class Simulation:
         if result.coverage is not None:
             payload["coverage"] = result.coverage
         self.log.emit("task_finished", robot.id, **payload)
+
+    def fault(self, robot: Robot, reason: str) -> None:
+        """The robot is down (it crashed, or a fault was injected): a ``fault`` event; its
+        running task fails, its queued ones are cancelled, and it takes no more rooms."""
+        if robot.faulted:
+            return
+        robot.faulted = True
+        self.log.emit("fault", robot.id, reason=reason)
+        self.handler(robot.id).fail(f"robot fault: {reason}")
+
+    def recover(self, robot: Robot) -> None:
+        """A faulted robot is back in service (in physics, set upright where it lies)."""
+        robot.faulted = False
+        self.cosim.recover(robot)
+        self.log.emit("recover", robot.id)
 
     # -- assignment ------------------------------------------------------------------------
     def assignment_round(self, segment: str, rooms: list[str], robots: list[Robot]) -> Assignment:

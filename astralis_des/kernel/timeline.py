@@ -29,8 +29,9 @@ TIMELINE_EVENTS: Registry[str, Handler] = Registry("timeline event")
 def search(sim: Simulation) -> Generator[simpy.Event, Any, str]:
     """Search each segment in turn; a round matches the free agents to its pending rooms.
 
-    A room whose search failed (a fault, no route) stays pending for the next round, up to
-    ``max_attempts`` rounds. Returns why the search stopped.
+    A room whose search failed (no route, stuck) stays pending for the next round, up to
+    ``max_attempts`` rounds; one whose searcher broke down (a fault, a crash) stays pending
+    without using an attempt. Returns why the search stopped.
     """
     attempts: Counter[str] = Counter()
     max_attempts = sim.mission.spec.assignment.max_attempts
@@ -46,12 +47,15 @@ def search(sim: Simulation) -> Generator[simpy.Event, Any, str]:
             plan = sim.assignment_round(segment, pending, agents)
             searches = dispatch(sim, plan)
             yield simpy.AllOf(sim.env, list(searches.values()))
+            searcher = {p.room: p.agent for p in plan.pairs}
             for room, done in searches.items():
                 outcome = cast(ActionResult, done.value)
                 if outcome.ok:
                     pending.remove(room)
                     sim.searched.append(room)
                     continue
+                if sim.robots[searcher[room]].faulted:
+                    continue  # the robot broke, not the room: another takes it next round
                 attempts[room] += 1
                 if attempts[room] >= max_attempts:
                     pending.remove(room)
@@ -84,16 +88,12 @@ def scheduled(sim: Simulation, event: Any) -> Generator[simpy.Event, Any, None]:
 
 @TIMELINE_EVENTS.register("fault")
 def _fault(sim: Simulation, event: FaultEvent) -> None:
-    robot = sim.robots[event.robot]
-    robot.faulted = True
-    sim.log.emit("fault", event.robot, reason=event.reason)
-    sim.handler(event.robot).fail(f"robot fault: {event.reason}")
+    sim.fault(sim.robots[event.robot], event.reason)
 
 
 @TIMELINE_EVENTS.register("recover")
 def _recover(sim: Simulation, event: RecoverEvent) -> None:
-    sim.robots[event.robot].faulted = False
-    sim.log.emit("recover", event.robot)
+    sim.recover(sim.robots[event.robot])
 
 
 @TIMELINE_EVENTS.register("room_change")

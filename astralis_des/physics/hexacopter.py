@@ -75,6 +75,7 @@ class Hexacopter:
         self.max_horizontal = min(spec.max_accel, GRAVITY * self.tilt)
         self._geometry = [(tuple(self.mix[i]), (float(self.rotors[i, 0]), float(self.rotors[i, 1])),
                            float(self.spin[i])) for i in range(ROTORS)]
+        self.hover_speed = hover
         self.rotor_speed = [hover] * ROTORS
 
     def state(self) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
@@ -88,9 +89,15 @@ class Hexacopter:
         pos, _ = self.client.call("getBasePositionAndOrientation", self.body)
         return np.array(pos)
 
+    def tilt_deg(self) -> float:
+        """Degrees between the body's z axis and the vertical."""
+        _, (qx, qy, _, _) = self.client.call("getBasePositionAndOrientation", self.body)
+        return math.degrees(math.acos(min(max(1.0 - 2.0 * (qx * qx + qy * qy), -1.0), 1.0)))
+
     def control(self, p_ref: Vec, v_ref: Vec, yaw_ref: float = 0.0,
-                a_ref: Vec = (0.0, 0.0, 0.0)) -> None:
-        """One controller update; the rotor forces hold until the next one.
+                a_ref: Vec = (0.0, 0.0, 0.0)) -> float:
+        """One controller update; the rotor forces hold until the next one. Returns how far
+        the craft is from ``p_ref`` (m).
 
         Written on plain floats: for 3-vectors, numpy's call overhead costs more than the
         arithmetic (``np.cross`` alone takes 20 us).
@@ -141,6 +148,8 @@ class Hexacopter:
         tz = jz * K_RATE[2] * (-K_ATT[2] * e2 - bz) + (bx * jy * by - by * jx * bx)
         self._rotors((thrust, tx, ty, tz), (px, py, pz),
                      (r00, r01, r02, r10, r11, r12, r20, r21, r22))
+        ex, ey, ez = p_ref[0] - px, p_ref[1] - py, p_ref[2] - pz
+        return math.sqrt(ex * ex + ey * ey + ez * ez)
 
     def _rotors(self, wrench: tuple[float, float, float, float], pos: Vec,
                 rot: tuple[float, ...]) -> None:

@@ -25,6 +25,7 @@ ARRIVED = 0.2  # m from the end of the path
 NEAR = 0.3  # m: a goal this close beside the robot counts as reached
 MAX_TURN_RATE = 1.2  # rad/s
 DECEL = 1.0  # m/s^2
+REST_Z = 0.155  # m: the base's height above the floor it stands on (measured at rest)
 
 
 class Husky:
@@ -33,7 +34,7 @@ class Husky:
         with quiet_c_output():
             self.body = int(client.call(
                 "loadURDF", "husky/husky.urdf", [float(start[0]), float(start[1]),
-                                                 float(start[2]) + 0.02],
+                                                 float(start[2]) + REST_Z],
                 flags=pb.URDF_USE_IMPLICIT_CYLINDER | pb.URDF_MERGE_FIXED_LINKS))
         names = {client.call("getJointInfo", self.body, j)[1].decode(): j
                  for j in range(client.call("getNumJoints", self.body))}
@@ -48,6 +49,7 @@ class Husky:
         self.speed = 1.0
         self.limit = math.inf  # m/s: a cap the local planner sets (obstacles ahead)
         self.offset = np.zeros(2)  # shift of the pursued point (keeping right)
+        self.spinning = False  # turning on the spot to face the path
         self.drive(0.0, 0.0)
 
     def pose(self) -> tuple[float, float, float, float]:
@@ -60,6 +62,12 @@ class Husky:
     def position(self) -> FloatArray:
         x, y, z, _ = self.pose()
         return np.array([x, y, z])
+
+    def tilt_deg(self) -> float:
+        """Degrees between the body's z axis and the vertical (roll and pitch together)."""
+        _, (qx, qy, _, _) = pb.getBasePositionAndOrientation(self.body,
+                                                             physicsClientId=self.client.id)
+        return math.degrees(math.acos(min(max(1.0 - 2.0 * (qx * qx + qy * qy), -1.0), 1.0)))
 
     def velocity_in_body(self) -> tuple[float, float]:
         """Forward and lateral speed, m/s: a non-holonomic robot keeps the second near 0."""
@@ -107,13 +115,15 @@ class Husky:
         return (float(np.interp(s, self.cum, self.path[:, 0])),
                 float(np.interp(s, self.cum, self.path[:, 1])))
 
-    def track(self) -> bool:
-        """One pure-pursuit update; true once the end of the path is reached."""
+    def track(self, arrive_within: float = ARRIVED) -> bool:
+        """One pure-pursuit update; true once the end of the path is reached (within
+        ``arrive_within``)."""
         x, y, _, yaw = self.pose()
         end = self.path[-1]
         remaining = math.hypot(end[0] - x, end[1] - y)
         beside = remaining < NEAR and abs(math.cos(math.atan2(end[1] - y, end[0] - x) - yaw)) < 0.5
-        if remaining < ARRIVED or beside:  # at the goal, or next to it: no turning on the spot
+        self.spinning = False
+        if remaining < arrive_within or beside:  # at the goal, or next to it: no turning
             self.drive(0.0, 0.0)
             return True
         self.progress = self._project(x, y)
@@ -122,6 +132,7 @@ class Husky:
         alpha = math.atan2(gy - y, gx - x) - yaw
         alpha = math.atan2(math.sin(alpha), math.cos(alpha))
         if abs(alpha) > math.pi / 3:  # face the path first: turn on the spot
+            self.spinning = True
             self.drive(0.0, math.copysign(MAX_TURN_RATE, alpha))
             return False
         distance = max(math.hypot(gx - x, gy - y), 1e-3)

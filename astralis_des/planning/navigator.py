@@ -33,6 +33,7 @@ CELL = 0.1  # m, walkers' floor grid
 class Route:
     points: FloatArray | None  # at the robot's sensor height; None when there is none
     reason: str = ""
+    skipped: int = 0  # points left out as unreachable (``refine(..., skip=True)``)
 
 
 class Navigator:
@@ -75,27 +76,52 @@ class Navigator:
         finally:
             self.seconds += time.perf_counter() - t0
 
-    def refine(self, robot: Robot, points: FloatArray) -> Route:
-        """Replace each leg a straight line cannot take by a planned detour."""
+    def refine(self, robot: Robot, points: FloatArray, skip: bool = False) -> Route:
+        """Replace each leg a straight line cannot take by a planned detour. With ``skip``
+        (a coverage path) a point no detour reaches is left out and counted, and the path
+        goes on to the next one; else the route fails there."""
         radius = BODY_RADIUS[robot.kind] + self.cfg.margin
         out = [points[0]]
-        for a, b in itertools.pairwise(points):
+        skipped = 0
+        for b in points[1:]:
+            a = out[-1]
             if float(np.linalg.norm(b - a)) < 1e-9 or self._leg_free(robot, a, b, radius):
                 out.append(b)
                 continue
             detour, reason = self._plan_leg(robot, a, b, radius)
             if detour is None:
+                if skip:
+                    skipped += 1
+                    continue
                 where = ", ".join(f"{v:.1f}" for v in b)
                 return Route(None, f"no path to [{where}]: {reason}")
             out.extend(detour[1:])
-        return Route(np.array(out))
+        return Route(np.array(out), skipped=skipped)
 
     def usable(self, robot: Robot, points: FloatArray) -> FloatArray:
         """The points of a coverage path the robot's body fits at (the others dropped)."""
         if self.method == "graph":
             return points
-        ok = self._valid(robot, points, BODY_RADIUS[robot.kind] + self.cfg.margin)
+        ok = self.fits(robot, points)
         return points[ok] if ok.any() else points[:0]
+
+    def fits(self, robot: Robot, points: FloatArray) -> np.ndarray:
+        """Where (``points`` at its sensor height) the robot's body is clear, by the check its
+        planner uses: a UAV's in the voxel map with the furniture, a walker's and the UGV's
+        on the grid of their floor's slice."""
+        pts = np.atleast_2d(np.asarray(points, dtype=float))
+        radius = BODY_RADIUS[robot.kind] + self.cfg.margin
+        if robot.kind == "uav":
+            return np.asarray(self._valid(robot, pts, radius))
+        ok = np.zeros(len(pts), dtype=bool)
+        floors = np.array([self.world.floor_below(p - np.array([0.0, 0.0, robot.height]))
+                           for p in pts])
+        for floor in np.unique(floors):
+            mine = floors == floor
+            lo = pts[mine, :2].min(axis=0) - radius - 2 * CELL
+            hi = pts[mine, :2].max(axis=0) + radius + 2 * CELL
+            ok[mine] = self._floor_grid(lo, hi, float(floor)).free(pts[mine, :2], radius)
+        return ok
 
     def prepare(self) -> None:
         """Build the planner's map now rather than on the first route (a server does, so

@@ -143,6 +143,15 @@ class World:
         return boxes_array([s.box for s in self.solids])
 
     @cached_property
+    def doorways(self) -> FloatArray:
+        """``(N, 3)`` centres (at floor height) of the openings in walls a robot passes
+        through: each room's door and each building's entrance."""
+        doors = [r.door.center for r in self.rooms.values() if r.building in self.buildings]
+        doors += [(b.footprint.hi[0], b.entrance[1], b.footprint.lo[2])
+                  for b in self.buildings.values()]
+        return np.array(doors, dtype=float).reshape(-1, 3)
+
+    @cached_property
     def router(self) -> Router:
         from astralis_des.world.routing import Router
 

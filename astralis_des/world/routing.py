@@ -17,6 +17,7 @@ from astralis_des.world.model import BLOCK, World
 KINDS = ("uav", "ugv", "human")
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
 STAIR_RUN_FACTOR = 2.0  # horizontal run of a flight of stairs per metre of rise
+UAV_WELL = 1.5  # m from the stairwell's far wall: where UAVs rise and sink between floors
 DOORWAY = 0.6  # m: routes cross a door square to its wall, from this far inside the room
 SNAP = 0.5  # m: a point this close to a room or corridor (in a wall, by a door) belongs to it
 # Not outdoor blockers: walls and slabs are inside footprints, and an imported world's blocks
@@ -99,6 +100,12 @@ class Router:
                 self._edge(node, corridor[0])
                 if previous is not None:
                     self._stairs(previous, node, stair.hi[1] - 0.5, passable)
+                if "uav" in passable:  # UAVs rise and sink at the far end, clear of the lift
+                    y_well = max(stair.hi[1] - UAV_WELL, self._pos[node][1])
+                    well = self._node(f"{b.id}.{floor}.well", (sx, y_well, z))
+                    self._edge(node, well, ("uav",))
+                    if floor > 1:
+                        self._edge(self.index[f"{b.id}.{floor - 1}.well"], well, ("uav",))
                 previous = node
             outside = self._node(f"{b.id}:entrance", b.entrance)
             self._edge(outside, self.corridor_nodes[f"{b.id}.1.corridor"][-1])
@@ -125,13 +132,15 @@ class Router:
                 self._edge(self.outdoor_nodes[a], self.outdoor_nodes[b_idx])
 
     def _stairs(self, lower: int, upper: int, y_max: float, passable: tuple[str, ...]) -> None:
-        """A UAV rises straight up the shaft; walkers and the UGV take a switchback flight
-        whose mid-landing makes the route as long as the stairs (run = 2 x rise)."""
+        """Between two floors of a stairwell: the UGV rides the vehicle lift straight up from
+        the landing (the stair node, by the corridor); walkers take a switchback flight whose
+        mid-landing makes the route as long as the stairs (run = 2 x rise). (UAVs rise in the
+        open well at the far end: ``_build``.)"""
         x, y, z0 = self._pos[lower]
         rise = self._pos[upper][2] - z0
-        if "uav" in passable:
-            self._edge(lower, upper, ("uav",))
-        walkers = tuple(k for k in passable if k != "uav")
+        if "ugv" in passable:
+            self._edge(lower, upper, ("ugv",))
+        walkers = tuple(k for k in passable if k not in ("uav", "ugv"))
         if walkers:
             run = STAIR_RUN_FACTOR * rise / 2
             mid = self._node(f"{self.names[lower]}:flight",
