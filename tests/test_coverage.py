@@ -151,3 +151,36 @@ def test_a_detection_estimates_the_position_with_seeded_noise(world: World) -> N
         return hit.estimate
 
     assert estimate(1) == estimate(1) != estimate(2)
+
+
+def test_an_inspect_point_under_a_table_is_skipped_not_failed() -> None:
+    """The operator's inspection loop has a corner under a table (the walker's planner, on
+    its floor grid, cannot stand there): the search succeeds without that corner, says so,
+    and walks the other corners; it does not fail the whole room."""
+    from astralis_des import Simulation, load_mission
+    from astralis_des.world.clutter import Clutter, Placed
+    from tests.conftest import MISSIONS
+
+    base = load_mission(MISSIONS / "fig7.yaml")
+    sim = Simulation(base.with_changes(
+        team=[{"id": "op1", "kind": "human", "start": [70.0, 78.25, 0.0]}],
+        planning={"method": "map"}, scene={"clutter": False}, time_limit=500,
+        target={"room": "A.1.2.1"},
+        assignment={**base.spec.assignment.model_dump(), "start_at": 400.0}))
+    room = sim.world.rooms["A.1.1.3"]
+    loop = cov.start_near(cov.loop(room.box, 1.0), room.box, np.array(room.door_point("room")))
+    far = loop[int(np.argmax(np.linalg.norm(loop - np.array(room.door.center[:2]), axis=1)))]
+    table = Placed("table", room.id, (float(far[0]), float(far[1]), 0.375), (1.2, 0.8, 0.75),
+                   0.0)
+    sim.scene.set_clutter(room.id, Clutter((table,)))
+    sim.start()
+    done = sim.enqueue("op1", "inspect", room.id)
+    sim.advance(300.0)
+    assert done.triggered
+    result = done.value
+    assert result.ok, result.message
+    assert result.message.endswith("(1 of 5 points out of reach)")
+    walked = np.array(sim.robots["op1"].trail_p)[:, :2]
+    assert np.linalg.norm(walked - far, axis=1).min() > 0.5  # never stood at that corner
+    others = [p for p in loop if np.linalg.norm(p - far) > 0.1]
+    assert all(np.linalg.norm(walked - p, axis=1).min() < 0.3 for p in others)

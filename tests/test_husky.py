@@ -41,3 +41,29 @@ def test_wheels_are_the_only_actuators(world: World) -> None:
     client.close()
     assert sorted(names) == ["front_left_wheel", "front_right_wheel", "rear_left_wheel",
                              "rear_right_wheel"]
+
+
+def test_a_sneak_peek_at_every_door_of_building_a_touches_no_wall() -> None:
+    """One UGV looks into all 18 rooms of building A in turn, riding the lift between
+    floors: every sneak peek succeeds, the robot stops where it can turn on the spot (its
+    half-diagonal and a margin from the wall), and its body never touches a wall."""
+    from astralis_des import Simulation, load_mission
+    from astralis_des.actions.common import stand_off
+    from tests.conftest import MISSIONS
+
+    base = load_mission(MISSIONS / "fig7.yaml")
+    sim = Simulation(base.with_changes(
+        fidelity="physics", team=[{"id": "ugv1", "kind": "ugv", "start": [70.0, 78.25, 0.0]}],
+        scene={"clutter": False}, time_limit=5000,
+        assignment={**base.spec.assignment.model_dump(), "start_at": 4000.0}))
+    robot = sim.robots["ugv1"]
+    assert stand_off(robot, 0.5) > 0.61 + 0.05  # the Husky's half-diagonal, and a margin
+    sim.start()
+    rooms = sorted(r for r in sim.world.rooms if r.startswith("A."))
+    assert len(rooms) == 18
+    peeks = [sim.enqueue("ugv1", "sneak_peek", room) for room in rooms]
+    sim.advance(1500.0)
+    results = [p.value for p in peeks if p.triggered]
+    assert len(results) == 18 and all(r.ok for r in results), [r.message for r in results]
+    assert [e for e in sim.log.records if e["kind"] == "contact"] == []
+    sim.finish()

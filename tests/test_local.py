@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from astralis_des import Simulation, load_mission
 from astralis_des.kernel.scene import Mover
@@ -58,4 +59,62 @@ def test_a_walker_crossing_the_ugvs_path_is_let_through() -> None:
     assert drive.triggered and drive.value.ok, drive.value.message
     assert [e for e in sim.log.records if e["kind"] == "contact"] == []
     assert sim.cosim.local.holds > 0  # it did wait for the walker
+    sim.finish()
+
+
+def _flight_past_avatar(uav_y: float, avatar_y: float) -> Simulation:
+    """A UAV flies east along the corridor at ``uav_y`` while an avatar walks west at
+    ``avatar_y``, 1.05 m to its left, over the same stretch (x 68.4 to 71.6)."""
+    sim = corridor_mission([{"id": "uav1", "kind": "uav", "start": [64.5, uav_y, 0.0]}])
+    walker = Mover("avatar:walker", "avatar",
+                   np.array([[71.6, avatar_y, 0.86], [68.4, avatar_y, 0.86],
+                             [71.6, avatar_y, 0.86]]), 0.6, (0.5, 0.5, 1.72))
+    sim.scene.movers.append(walker)
+    sim.cosim._add_movers([walker])
+    sim.start()
+    done = sim.enqueue("uav1", "move", params={"x": 76.0, "y": uav_y})
+    sim.advance(30.0)
+    assert done.triggered and done.value.ok, done.value.message
+    return sim
+
+
+def test_keep_right_ignores_an_avatar_behind_a_wall() -> None:
+    """The avatar walks in the room beside the corridor (room A.1.1.2, 0.35 m beyond the
+    wall): the UAV flies straight on, never shifted. The same avatar the same distance away
+    in the corridor makes it keep right."""
+    behind = _flight_past_avatar(78.9, 79.95)
+    assert behind.cosim.local.shifts == 0
+    ys = np.array(behind.robots["uav1"].trail_p)[:, 1]
+    assert np.abs(ys - 78.9).max() < 0.1
+    behind.finish()
+    in_sight = _flight_past_avatar(77.95, 79.0)
+    assert in_sight.cosim.local.shifts > 0
+    assert np.array(in_sight.robots["uav1"].trail_p)[:, 1].min() < 77.95 - 0.2
+    in_sight.finish()
+
+
+DOORS = [(70.0, 79.5), (66.0, 79.5), (74.0, 79.5), (66.0, 77.0), (70.0, 77.0), (74.0, 77.0)]
+
+
+@pytest.mark.parametrize("door", DOORS, ids=lambda d: f"door_{d[0]:g}_{d[1]:g}")
+def test_a_uav_and_a_walker_cross_a_doorway_head_on_without_touching(
+        door: tuple[float, float]) -> None:
+    """In every doorway of the ground floor: the UAV flies from the corridor into the room
+    as the operator walks out of it into the corridor. Both get there, and the UAV touches
+    neither the door's jambs nor the operator."""
+    x, y = door
+    inward = 1.0 if y > CORRIDOR_Y else -1.0
+    room = (x, y + inward * 3.4)
+    sim = corridor_mission([
+        {"id": "uav1", "kind": "uav", "start": [x + 2.0, CORRIDOR_Y, 0.0]},
+        {"id": "op1", "kind": "human", "start": [x - 0.8, room[1], 0.0]},
+    ])
+    sim.start()
+    fly = sim.enqueue("uav1", "move", params={"x": room[0], "y": room[1]})
+    walk = sim.enqueue("op1", "move", params={"x": x - 2.0, "y": CORRIDOR_Y})
+    sim.advance(60.0)
+    assert fly.triggered and walk.triggered
+    assert fly.value.ok and walk.value.ok, (fly.value.message, walk.value.message)
+    assert [e for e in sim.log.records if e["kind"] == "contact"
+            and "uav1" in (e.get("robot"), e.get("other"))] == []
     sim.finish()

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import shutil
 import tempfile
-from collections.abc import Generator
+from collections.abc import Callable, Generator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -26,11 +26,11 @@ from astralis_des.cosim.kinematic import MotionOutcome
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kernel.scene import Mover
 from astralis_des.physics.client import PhysicsClient
-from astralis_des.physics.drivers import DRIVERS, Driver
+from astralis_des.physics.drivers import DRIVERS, Driver, HumanDriver
 from astralis_des.physics.hexacopter import write_urdf
 from astralis_des.physics.lift import Lift, lifts_of
 from astralis_des.physics.local import RATE as LOCAL_RATE
-from astralis_des.physics.local import LocalLayer
+from astralis_des.physics.local import LocalLayer, aside
 from astralis_des.physics.perception import Perception
 from astralis_des.physics.ugv_driver import UgvDriver
 from astralis_des.sensing import GeometricSensor, Sighting
@@ -43,6 +43,7 @@ if TYPE_CHECKING:
 CONTACT_CHECKS_PER_S = 30
 PROGRESS = 0.1  # m of its path a moving robot must make good within stuck_timeout
 SUPPORT = 0.7  # a contact normal steeper than this holds a ground robot up: not a collision
+FLOORS = ("wall", "ground", "lift")  # what holds a ground robot up (slabs are static boxes)
 CAP_FACTOR, CAP_SLACK = 2.0, 30.0  # a motion planned to take T s fails after 2 T + 30 s
 TURN_CAP = 30.0  # s: a turn on the spot that takes longer has failed
 
@@ -98,10 +99,12 @@ class PhysicsCoSim:
         self.names[self.client.ground] = "ground"
         self.lifts = lifts_of(sim.world, self.client)
         self.names.update({lift.body: "lift" for lift in self.lifts})
-        for driver in self.drivers.values():
+        for rid, driver in self.drivers.items():
             if isinstance(driver, UgvDriver):
                 driver.lifts = self.lifts
                 driver.column_busy = self._column_busy
+            if isinstance(driver, HumanDriver):
+                driver.bodies_near = self._bodies_near(rid)
         self._scene = sim.scene
         self.robots = sim.robots
         self._navigator = sim.navigator
@@ -114,6 +117,7 @@ class PhysicsCoSim:
         self.touching: set[tuple[str, str]] = set()
         self._wake: simpy.Event = self.env.event()
         self._next_log = 0.0
+        self._no_room: dict[str, float] = {}  # robots that found no spot to make way, until
         self._ticks = 0
         self.env.process(self._stepper())
 
@@ -159,6 +163,21 @@ class PhysicsCoSim:
             body = self.client.add_box(mover.position_at(self.t), mover.size)
             self.movers.append((mover, body))
             self.names[body] = mover.kind
+
+    def _bodies_near(self, rid: str) -> Callable[[FloatArray], list[int]]:
+        """For a walker: the bodies of the other robots (UAVs, UGVs) within 1.5 m of a point,
+        and the lifts'."""
+        others = [d for other, d in self.drivers.items()
+                  if other != rid and not isinstance(d, HumanDriver)]
+
+        def near(point: FloatArray) -> list[int]:
+            found = [d.body for d in others
+                     if abs(float(d.position()[0]) - float(point[0])) < 1.5
+                     and abs(float(d.position()[1]) - float(point[1])) < 1.5]
+            return found + [lift.body for lift in self.lifts
+                            if lift.contains(point, 1.0)]
+
+        return near
 
     def _column_busy(self, lift: Lift, rider: str) -> bool:
         """Is another robot in the lift's column (on any floor: the lift waits for it)?"""
@@ -267,6 +286,7 @@ class PhysicsCoSim:
             yield env.timeout(max(self.t - env.now, 0.0))
             for rid, outcome in finished:
                 self._finish(rid, outcome)
+            self._make_way()
 
     def _advance(self, ticks: int) -> list[tuple[str, MotionOutcome]]:
         """Step up to ``ticks`` control periods; stop at the first that ends a motion."""
@@ -274,8 +294,10 @@ class PhysicsCoSim:
         local_every = max(1, round(1.0 / (LOCAL_RATE * self.period)))
         for _ in range(ticks):
             check = self._ticks % check_every == 0
+            make_way = False
             if self._ticks % local_every == 0:
                 self.local.update(self.t)
+                make_way = bool(self.local.requests)  # end the macro-step after this tick
             finished = [(rid, out) for rid, (robot, track, _) in self.active.items()
                         if (out := self._tick(rid, track, check)) is not None]
             if finished:
@@ -291,6 +313,8 @@ class PhysicsCoSim:
                 self._next_log = self.t + 1.0 / self.spec.log_rate
                 for _, track, _ in self.active.values():
                     track.sample(self.t)
+            if make_way:
+                return []
         return []
 
     def _tick(self, rid: str, track: Track, check: bool) -> MotionOutcome | None:
@@ -318,8 +342,32 @@ class PhysicsCoSim:
             return MotionOutcome(False, f"timed out: not there after {track.cap:.0f} s")
         return None
 
+    def may_ask(self, rid: str) -> bool:
+        """May a robot be asked to make way now (not while it found no room lately)?"""
+        return self._no_room.get(rid, -1.0) <= self.t and not self.robots[rid].faulted
+
+    def _make_way(self) -> None:
+        """Robots standing idle in another's way move to the nearest free spot off its path
+        (asked by the local layer during the last macro-step)."""
+        requests, self.local.requests = self.local.requests, {}
+        for rid, (asker, path) in sorted(requests.items()):
+            robot = self.robots[rid]
+            if rid in self.active or robot.faulted or self._no_room.get(rid, -1.0) > self.t:
+                continue
+            here = self.drivers[rid].position()
+            spot = aside(self, robot, here, path, self.robots[asker].kind)
+            if spot is None:
+                self._no_room[rid] = self.t + 2.0  # nowhere to go: ask again later
+                continue
+            self.log.emit("make_way", rid, at=self.t, for_robot=asker, to=spot)
+            motion = Motion(np.array([here, spot]), robot.speed, accel=robot.accel,
+                            turn_rate=robot.turn_rate, heading=robot.heading)
+            self.execute(robot, motion)
+
     def _finish(self, rid: str, outcome: MotionOutcome) -> None:
         robot, track, done = self.active.pop(rid)
+        if outcome.fault:  # it comes down where it is and lies there, a still body
+            self.drivers[rid].fall(self.world.on_floor(self.drivers[rid].position()))
         track.sample(self.env.now)
         self.drivers[rid].freeze()
         robot.halt(self.env.now)
@@ -333,7 +381,7 @@ class PhysicsCoSim:
             body = self.drivers[rid].body
             for c in self.client.call("getContactPoints", bodyA=body):
                 other = self.names.get(c[2], "object")
-                if robot.kind != "uav" and other in ("wall", "ground") and c[7][2] > SUPPORT:
+                if robot.kind != "uav" and other in FLOORS and c[7][2] > SUPPORT:
                     continue  # wheels or feet on a floor
                 key = (rid, other)
                 now.add(key)

@@ -65,6 +65,8 @@ class Motion:
         dt = np.asarray(times, dtype=float) - self.t0
         s = self.profile.arc(dt)
         pos = np.column_stack([np.interp(s, self.cum, self.points[:, k]) for k in range(3)])
+        if len(self.points) < 2:  # a path of one point: there, still
+            return pos, np.zeros_like(pos)
         legs = np.diff(self.points, axis=0)
         norms = np.linalg.norm(legs, axis=1)
         unit = np.divide(legs, norms[:, None], out=np.zeros_like(legs), where=norms[:, None] > 0)

@@ -10,6 +10,7 @@ modules and register here.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Protocol
 
@@ -30,6 +31,7 @@ SAMPLE = 0.2  # m between the points of a path ahead
 class Driver(Protocol):
     body: int
     held: bool
+    shift: FloatArray
     arrive_within: float
 
     def start(self, motion: Motion, t: float) -> None: ...
@@ -43,6 +45,7 @@ class Driver(Protocol):
     def avoid(self, hold: bool, shift: FloatArray, climb: float = 0.0) -> None: ...
     def slow_down(self, share: float) -> None: ...
     def crashed(self) -> str | None: ...
+    def fall(self, floor: FloatArray) -> None: ...
     def recover(self, at: FloatArray) -> None: ...
 
 
@@ -81,11 +84,16 @@ class HumanDriver(Avoiding):
     """Walks the path at its speed, kinematically: a capsule placed at each tick."""
 
     def __init__(self, client: PhysicsClient, robot: Robot, spec: PhysicsSpec, urdf: Path) -> None:
+        self.client = client
         self.offset = np.array([0.0, 0.0, robot.height - (RADIUS + HEIGHT / 2)])
         self.period = 1.0 / spec.control_rate
         self.walker = Walker(client, robot.pose - self.offset)
         self.body = self.walker.body
+        self.placed = np.asarray(robot.pose - self.offset, dtype=float)
         self.motion: Motion | None = None
+        # the bodies of the robots near a point (set by the co-simulation): a walker is
+        # placed, not pushed, so it must not step into one of them
+        self.bodies_near: Callable[[FloatArray], list[int]] = lambda point: []
         self._clear_avoidance()
 
     def start(self, motion: Motion, t: float) -> None:
@@ -112,16 +120,31 @@ class HumanDriver(Avoiding):
 
     def tick(self, t: float) -> str | None:
         assert self.motion is not None
+        before = (self.elapsed, self.shift, self.placed)
         if not self.held:
             self.elapsed += self.period
         self.shift = ramp(self.shift, self.shift_to, self.shift_rate * self.period)
         where = self.motion.at(self.motion.t0 + self.elapsed) - self.offset
         where[:2] += self.shift
+        near = self.bodies_near(where)
+        depth = self._overlap(near)
         self.walker.place(where)
+        self.placed = where
+        if near and self._overlap(near) > depth + 1e-4:  # it would step into a robot: wait
+            self.elapsed, self.shift, self.placed = before
+            self.walker.place(self.placed)
         if self.elapsed >= self.motion.duration:
             return "arrived"
         remaining = self.motion.length - self.progress()
         return "arrived" if remaining < self.arrive_within - ARRIVED else None
+
+    def _overlap(self, bodies: list[int]) -> float:
+        """How deep the walker is in any of ``bodies`` where it stands now (0 if in none)."""
+        deepest = 0.0
+        for body in bodies:
+            for c in self.client.call("getClosestPoints", self.body, body, 0.0):
+                deepest = max(deepest, -float(c[8]))
+        return deepest
 
     def position(self) -> FloatArray:
         return self.walker.position() + self.offset
@@ -129,6 +152,9 @@ class HumanDriver(Avoiding):
     def crashed(self) -> str | None:
         """A walker is placed, not simulated: it does not fall."""
         return None
+
+    def fall(self, floor: FloatArray) -> None:
+        """A walker does not crash."""
 
     def recover(self, at: FloatArray) -> None:
         self.walker.place(at + np.array([0.0, 0.0, RADIUS + HEIGHT / 2]))

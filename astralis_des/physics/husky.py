@@ -110,6 +110,10 @@ class Husky:
                 break
         return max(best_s, self.progress)
 
+    def aim(self) -> tuple[float, float]:
+        """Where it is headed: the pursued point of its path (not the way it faces)."""
+        return self._point_at(self.progress + LOOKAHEAD)
+
     def _point_at(self, s: float) -> tuple[float, float]:
         s = min(s, float(self.cum[-1]))
         return (float(np.interp(s, self.cum, self.path[:, 0])),

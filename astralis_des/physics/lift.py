@@ -1,13 +1,13 @@
-"""The vehicle lift of a building's stairwell: a platform the UGV drives onto, rides to
-another floor and drives off, in the stairwell's column next to the corridor.
+"""The vehicle lift of a building's stairwell: a platform the UGV drives onto from the
+landing, rides to another floor and drives off, in its own shaft at the stairwell's far end
+(``Building.lift``; walkers and UAVs keep to the landing and the open well).
 
 The platform is a static box moved by setting its pose (a kinematic body, like the walkers),
 and the UGV on it is carried the same way, so it rides without bouncing. Above the ground
-floor the stairwell has no slab: the platform is the floor the UGV stands on, and it stays at
-the floor where the UGV left it. One UGV at a time: a UGV reserves the lift when it comes near
-the column and frees it when its body has left the column. The lift moves only while no other
-robot is inside its column (a UAV crossing the stairwell, a person on the landing), and the
-local layer makes the others wait outside the column while it moves.
+floor the shaft has no slab: the platform is the floor the UGV stands on, and it stays at the
+floor where the UGV left it. One UGV at a time: a UGV reserves the lift when it comes near
+the shaft and frees it when its body has left it. The lift moves only while no other robot is
+inside the shaft, and the local layer makes the others wait outside it while it moves.
 """
 
 from __future__ import annotations
@@ -85,17 +85,8 @@ class Lift:
 
 
 def lifts_of(world: World, client: PhysicsClient) -> list[Lift]:
-    """A lift in the stairwell of each building whose stairs the UGV may use: the column
-    between the stairwell's west wall and the corridor, as wide as the corridor."""
-    lifts = []
-    for b in world.buildings.values():
-        if "ugv" not in world.stairs_passable_by.get(b.id, ("ugv",)):
-            continue
-        stair = world.spaces.get(f"{b.id}.stairwell")
-        corridor = world.spaces.get(f"{b.id}.1.corridor")
-        if stair is None or corridor is None:
-            continue
-        lo = np.array([stair.box.lo[0] + GAP, corridor.box.lo[1] + GAP])
-        hi = np.array([corridor.box.lo[0] - GAP, corridor.box.hi[1] - GAP])
-        lifts.append(Lift(client, b.id, lo, hi, z=float(b.footprint.lo[2])))
-    return lifts
+    """A lift in the shaft of each building whose stairs the UGV may use."""
+    return [Lift(client, b.id, np.array(b.lift.lo[:2]) + GAP, np.array(b.lift.hi[:2]) - GAP,
+                 z=float(b.footprint.lo[2]))
+            for b in world.buildings.values()
+            if b.lift is not None and "ugv" in world.stairs_passable_by.get(b.id, ("ugv",))]

@@ -5,29 +5,35 @@ Only bodies in the same free space count (a straight line between the two crosse
 an avatar in the next room is no reason to move. The rules, as people keep to in corridors:
 - keep right: something coming head-on in or near the robot's lane makes it shift to its
   right, by as much as keeps the whole path ahead (``PATH_AHEAD``) clear of walls and
-  furniture; never near a doorway or with one on the path ahead, where it keeps to its path;
-- hold: something in the robot's lane, closer than its stopping range, makes it wait (its
-  reference stops). Between two robots only the lower-priority one holds (team order);
-  scripted movers, the lift and robots standing still never yield, so robots do;
+  furniture; never in a doorway or with one on the path ahead, where it keeps to its path;
+- hold: something ahead on the robot's route, closer than its stopping range, makes it wait
+  (its reference stops). Head-on between two robots only the lower-priority one holds (team
+  order); scripted movers, the lift and robots standing still never yield, so robots do; and
+  a robot keeps its distance behind one going its way;
 - doorways are taken in turn: a robot with a doorway on its path ahead waits while another
   body is in it, or while a robot of higher priority is about to cross it;
 - step aside: something standing still in the lane is passed on the side with room;
-- a UAV climbs over a walker (a person or an avatar) on a collision course with it;
-- a goal another body stands on counts as reached from farther away.
+- a UAV on a walker's (a person's, an avatar's) collision course climbs and waits above it
+  until it has passed below;
+- a robot standing idle in another's way (in its lane, in the doorway it waits for, on its
+  goal) is asked to make way: it moves to the nearest free spot off the other's path
+  (:meth:`PhysicsCoSim.make_way`); a goal a body stands on counts as reached from farther.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from astralis_des.physics.drivers import SAMPLE
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
 if TYPE_CHECKING:
     from astralis_des.cosim.physics import PhysicsCoSim
+    from astralis_des.kernel.robot import Robot
     from astralis_des.physics.drivers import Driver
 
 PASS_RANGE = 5.0  # m: closer than this, head-on, both keep right
@@ -42,13 +48,16 @@ STILL_RANK = 10_000  # movers, the lift, and robots not moving: everyone yields 
 NEAR = 6.0  # m: movers farther than this from every moving robot need not move in physics
 RATE = 5.0  # Hz: how often the layer decides (a UAV flies 0.3 m in between)
 PATH_AHEAD = 3.0  # m of its path that a shifted robot must keep clear
-DOOR_NEAR = 1.2  # m: this near a doorway, or with one this near its path ahead, no shift
+DOOR_IN = 0.6  # m off a doorway's wall line (and within its width) is in the doorway
+DOOR_HALF_WIDTH = 0.7  # m along the wall from a doorway's centre that count as in it
 DOOR_ON_PATH = 0.4  # m: a path passing this near a doorway's centre goes through it
 DOOR_BUSY = 1.0  # m: a body this near a doorway is in it; the others wait
 GOAL_TAKEN = 2.8  # m: a goal another body stands still on is reached this near
 CLIMB_MARGIN = 0.3  # m a climbing UAV keeps above a walker's head
 CLIMB_SOON = 3.0  # s: a walker this close to meeting a UAV makes it climb
 WALKERS = ("human", "avatar")
+SHARES = (1.0, 2 / 3, 1 / 3)  # of a keep-right shift, tried in turn
+MAKE_WAY_PATH = 6.0  # m of the asking robot's path that a robot making way keeps off
 
 
 @dataclass
@@ -61,6 +70,7 @@ class Body:
     radius: float
     rank: int  # lower yields to higher; movers rank above every robot
     base_z: tuple[float, float] = (0.0, 0.0)  # a UAV's band before any climb
+    offset: FloatArray = field(default_factory=lambda: np.zeros(2))  # its shift off its path
 
 
 class LocalLayer:
@@ -71,6 +81,8 @@ class LocalLayer:
         self.shifts = 0  # how many times a robot was shifted aside
         self.climbs = 0  # how many times a UAV climbed over a walker
         self.near: list[int] = []  # movers within NEAR of a moving robot: the ones to move
+        # robots standing in another's way: who asks them to make way, and its path ahead
+        self.requests: dict[str, tuple[str, FloatArray]] = {}
         self.solids = cosim.world.solid_array
         self.doors = cosim.world.doorways
 
@@ -87,7 +99,7 @@ class LocalLayer:
             course = driver.course_z() if hasattr(driver, "course_z") else here[2]
             found.append(Body(rid, robot.kind, here[:2], velocity,
                               (here[2] + low, here[2] + high), RADII[robot.kind], rank,
-                              (course + low, course + high)))
+                              (course + low, course + high), driver.shift))
         for mover, _ in self.cosim.movers:
             here = mover.position_at(t)
             ahead = mover.position_at(t + 0.5)
@@ -130,17 +142,29 @@ class LocalLayer:
         forward = direction / speed
         right = np.array([forward[1], -forward[0]])
         near = np.linalg.norm(where - me.xy, axis=1) < PASS_RANGE + 1.0
-        others = [b for b, c in zip(bodies, near, strict=True)
-                  if c and b.name != me.name and self._same_space(me, b)]
-        hold, shift = self._decide(me, others, forward, right, speed)
+        others = self._in_sight(me, [b for b, c in zip(bodies, near, strict=True)
+                                     if c and b.name != me.name])
+        route = ahead[:, :2] + me.offset
+        if len(route) < 3:  # at the end of its path: the way it is headed
+            route = me.xy + forward * np.arange(0.0, PATH_AHEAD, SAMPLE)[:, None]
+        hold, shift, aside, blockers = self._decide(me, others, forward, right, speed, route)
         door = doors[rid]
-        if door is not None and self._door_taken(rid, me, door, others, doors):
+        in_door = self._door_taken(rid, me, door, others, doors) if door is not None else None
+        if in_door is not None:
             hold = True
-        driver.arrive_within = GOAL_TAKEN if self._goal_taken(driver, me, others) else 0.2
-        open_space = door is None and not self._by_doorway(me.xy, me.base_z[0])
-        climb = self._climb(me, others, ahead) if me.kind == "uav" and open_space else 0.0
+            blockers.append(in_door)
+        occupant = self._goal_taken(driver, me, others)
+        driver.arrive_within = GOAL_TAKEN if occupant is not None else 0.2
+        for other in [*blockers, *([occupant] if occupant else [])]:
+            if other.name in self.cosim.drivers and other.name not in self.cosim.active and \
+                    self.cosim.may_ask(other.name):
+                self.requests.setdefault(other.name, (rid, driver.path_ahead(MAKE_WAY_PATH)))
+        in_doorway = self._by_doorway(me.xy, me.base_z[0])
+        open_space = door is None and not in_doorway
+        climb = self._climb(me, others) if me.kind == "uav" and not in_doorway else 0.0
+        hold = hold or climb > 0.0  # it waits above the walker until it has passed below
         if shift and open_space:
-            shift = self._clear_shift(me, ahead, right, shift)
+            shift = self._clear_shift(me, ahead, right, shift, (1.0,) if aside else SHARES)
         elif shift:
             shift = 0.0
         self.holds += hold
@@ -148,50 +172,62 @@ class LocalLayer:
         self.climbs += bool(climb)
         driver.avoid(hold, right * shift, climb)
 
-    def _decide(self, me: Body, others: list[Body], forward: FloatArray,
-                right: FloatArray, speed: float = 1.0) -> tuple[bool, float]:
-        hold, shift = False, 0.0
+    def _decide(self, me: Body, others: list[Body], forward: FloatArray, right: FloatArray,
+                speed: float, route: FloatArray) -> tuple[bool, float, bool, list[Body]]:
+        """Hold or not, the shift to the right off the path (left if negative), whether that
+        shift steps round something standing still (all of it, or no use), and the bodies
+        the robot holds for. ``route``: where the robot will be over the next metres (its
+        path ahead, as shifted now), ``SAMPLE`` apart."""
+        hold, shift, aside = False, 0.0, False
+        blockers: list[Body] = []
+        stop = STOP_RANGE + BRAKING * speed
         for other in others:
             if other.z[1] < me.z[0] or other.z[0] > me.z[1]:
                 continue  # above or below it (a UAV over the UGV)
             rel = other.xy - me.xy
             along, across = float(rel @ forward), float(rel @ right)
+            from_path = across + float(me.offset @ right)  # across, from the unshifted path
             gap = math.hypot(along, across) - me.radius - other.radius
             lane = me.radius + other.radius + LANE_MARGIN
-            if along <= 0 or gap > PASS_RANGE:
+            if gap > PASS_RANGE:
                 continue
-            if float(other.velocity @ forward) < -0.05:
-                if abs(across) < lane + SHIFT:  # it comes towards us, close: keep right
-                    shift = max(shift, SHIFT)
-            elif float(np.linalg.norm(other.velocity)) < 0.05 and abs(across) < lane:
-                # standing in our lane: pass it on the side with more room
-                side = across - lane if across >= 0 else across + lane
-                shift = side if abs(side) > abs(shift) else shift
-            soon = rel + other.velocity * LOOK_AHEAD
-            in_lane = abs(across) < lane or (float(soon @ forward) > 0 and
-                                             abs(float(soon @ right)) < lane)
-            if in_lane and gap < STOP_RANGE + BRAKING * speed and other.rank > me.rank:
+            reach, off_route = _on_route(route, other.xy, other.velocity)
+            if along > 0 and off_route < lane + SHIFT:
+                if float(other.velocity @ forward) < -0.05:
+                    if abs(from_path) < lane + SHIFT:  # it comes towards us, close: keep right
+                        shift, aside = max(shift, SHIFT), False
+                elif float(np.linalg.norm(other.velocity)) < 0.05 and abs(from_path) < lane:
+                    # standing in our lane: pass it on the side away from it, clear of it
+                    side = from_path - lane - 0.05 if from_path >= 0 else from_path + lane + 0.05
+                    if abs(side) > abs(shift):
+                        shift, aside = side, True
+            ahead = along > 0 and reach - me.radius - other.radius < stop and off_route < lane
+            # hold for a body of higher priority ahead, and for any ahead going our way (it
+            # is followed at a distance, not pushed)
+            if ahead and (other.rank > me.rank or float(other.velocity @ forward) > 0.05):
                 hold = True
-        return hold, shift
+                blockers.append(other)
+        return hold, shift, aside, blockers
 
     # -- the free space around a robot ------------------------------------------------------
-    def _same_space(self, me: Body, other: Body) -> bool:
-        """Can the two see each other: does the line between them cross no wall or slab?"""
-        z = (max(me.z[0], other.z[0]) + min(me.z[1], other.z[1])) / 2
-        if other.kind == "lift":
-            return True
-        a, b = np.array([[*me.xy, z]]), np.array([[*other.xy, z]])
-        return not bool(segments_hit_boxes(a, b, self.solids)[0])
+    def _in_sight(self, me: Body, others: list[Body]) -> list[Body]:
+        """The bodies in the same free space as ``me``: the line between the two (at a height
+        both span) crosses no wall or slab. The lift counts whatever is between."""
+        if not others:
+            return others
+        z = [(max(me.z[0], o.z[0]) + min(me.z[1], o.z[1])) / 2 for o in others]
+        a = np.column_stack([np.repeat(me.xy[None, :], len(others), axis=0), z])
+        b = np.column_stack([np.array([o.xy for o in others]), z])
+        hidden = segments_hit_boxes(a, b, self.solids)
+        return [o for o, h in zip(others, hidden, strict=True) if o.kind == "lift" or not h]
 
-    def _clear_shift(self, me: Body, ahead: FloatArray, right: FloatArray,
-                     shift: float) -> float:
+    def _clear_shift(self, me: Body, ahead: FloatArray, right: FloatArray, shift: float,
+                     shares: tuple[float, ...]) -> float:
         """The largest share of ``shift`` that keeps the path ahead clear, or 0."""
-        for share in (1.0, 2 / 3, 1 / 3):
-            points = np.vstack([np.array([[*me.xy, ahead[0, 2]]]), ahead])
-            points[:, :2] += right * (shift * share)
-            if self.cosim.fits(me.name, points).all():
-                return shift * share
-        return 0.0
+        points = np.concatenate([ahead + np.array([*(right * (shift * share)), 0.0])
+                                 for share in shares])  # from the robot's unshifted place on
+        fits = self.cosim.fits(me.name, points).reshape(len(shares), len(ahead)).all(axis=1)
+        return shift * shares[int(np.argmax(fits))] if fits.any() else 0.0
 
     # -- doorways ----------------------------------------------------------------------------
     def _doors_on(self, floor_z: float) -> FloatArray:
@@ -199,10 +235,17 @@ class LocalLayer:
             self.doors
 
     def _by_doorway(self, xy: FloatArray, low: float) -> bool:
+        """Is ``xy`` in a doorway: within ``DOOR_IN`` of its wall's line, and within the
+        door's width (and a little) of its centre along the wall?"""
         floor = self.cosim.world.floor_below((float(xy[0]), float(xy[1]), max(low, 0.0)))
         doors = self._doors_on(floor)
-        return bool(len(doors)) and float(np.min(np.linalg.norm(doors[:, :2] - xy, axis=1))) \
-            < DOOR_NEAR
+        if not len(doors):
+            return False
+        normal = doors[:, 3].astype(int)
+        rows = np.arange(len(doors))
+        off_wall = np.abs(xy[normal] - doors[rows, normal])
+        along_wall = np.abs(xy[1 - normal] - doors[rows, 1 - normal])
+        return bool(np.any((off_wall < DOOR_IN) & (along_wall < DOOR_HALF_WIDTH)))
 
     def _door_ahead(self, me: Body, ahead: FloatArray) -> int | None:
         """The doorway the path ahead goes through first (an index into ``doors``)."""
@@ -215,24 +258,25 @@ class LocalLayer:
         return int(hit[0, 1]) if len(hit) else None
 
     def _door_taken(self, rid: str, me: Body, door: int, others: list[Body],
-                    doors: dict[str, int | None]) -> bool:
-        """Must this robot wait for the doorway on its path? Not once it is in it."""
+                    doors: dict[str, int | None]) -> Body | None:
+        """Whom must this robot wait for at the doorway on its path? No one once it is in
+        it."""
         centre = self.doors[door, :2]
         if float(np.linalg.norm(me.xy - centre)) < DOOR_BUSY:
-            return False
+            return None
         for other in others:
             if other.z[1] < me.z[0] or other.z[0] > me.z[1] or other.kind == "lift":
                 continue
             if float(np.linalg.norm(other.xy - centre)) < DOOR_BUSY:
-                return True  # someone is in the doorway
+                return other  # someone is in the doorway
             if doors.get(other.name) == door and other.rank > me.rank and \
                     other.rank != STILL_RANK:
-                return True  # a robot of higher priority is about to go through
-        return False
+                return other  # a robot of higher priority is about to go through
+        return None
 
     # -- goals and walkers ----------------------------------------------------------------
-    def _goal_taken(self, driver: Driver, me: Body, others: list[Body]) -> bool:
-        """Does another body stand still on this robot's goal?"""
+    def _goal_taken(self, driver: Driver, me: Body, others: list[Body]) -> Body | None:
+        """The body standing still on this robot's goal, if any."""
         goal = driver.goal_point()
         low, high = HEIGHTS[me.kind]
         for other in others:
@@ -241,11 +285,12 @@ class LocalLayer:
             if other.z[1] < goal[2] + low or other.z[0] > goal[2] + high:
                 continue
             if float(np.linalg.norm(other.xy - goal[:2])) < me.radius + other.radius + 0.1:
-                return True
-        return False
+                return other
+        return None
 
-    def _climb(self, me: Body, others: list[Body], ahead: FloatArray) -> float:
-        """How far a UAV climbs to pass over a walker on a collision course with it."""
+    def _climb(self, me: Body, others: list[Body]) -> float:
+        """How far a UAV climbs (where it is) to let a walker on a collision course with it
+        pass below."""
         need = 0.0
         for other in others:
             if other.kind not in WALKERS or other.z[1] < me.base_z[0]:
@@ -256,8 +301,8 @@ class LocalLayer:
                 need = max(need, other.z[1] + CLIMB_MARGIN - me.base_z[0])
         if need <= 0.0:
             return 0.0
-        above = np.array([[*me.xy, me.base_z[1] + need], *[[*p[:2], p[2] + need]
-                                                           for p in ahead[:3]]])
+        centre = (me.base_z[0] + me.base_z[1]) / 2
+        above = np.array([[*me.xy, centre + need]])
         return need if self.cosim.fits(me.name, above).all() else 0.0
 
 
@@ -267,3 +312,47 @@ def _closest_approach(rel: FloatArray, velocity: FloatArray, horizon: float) -> 
     speed2 = float(velocity @ velocity)
     t = 0.0 if speed2 < 1e-9 else min(max(-float(rel @ velocity) / speed2, 0.0), horizon)
     return float(np.linalg.norm(rel + velocity * t))
+
+
+ASIDE_STEPS = (1.0, 1.5, 2.0)  # m: how far a robot making way may go
+ASIDE_DIRECTIONS = 16
+
+
+def aside(cosim: PhysicsCoSim, robot: Robot, here: FloatArray, path: FloatArray,
+          asker_kind: str) -> FloatArray | None:
+    """The nearest spot (at ``here``'s height, on the same floor) where ``robot`` is clear of
+    ``path`` by both bodies' radii and a margin, fits among walls and furniture, is not in a
+    doorway, and is reached in a straight line: where it goes to make way, or None."""
+    angles = np.arange(ASIDE_DIRECTIONS) * (2 * math.pi / ASIDE_DIRECTIONS)
+    rings = [here + np.column_stack([np.cos(angles), np.sin(angles), np.zeros(len(angles))]) * r
+             for r in ASIDE_STEPS]
+    spots = np.vstack(rings)
+    clear_of = RADII[robot.kind] + RADII[asker_kind] + 0.3
+    gaps = np.linalg.norm(spots[:, None, :2] - path[None, :, :2], axis=2).min(axis=1)
+    doors = cosim.world.doorways
+    floor = cosim.world.floor_below(here - np.array([0.0, 0.0, robot.height]))
+    near_door = np.zeros(len(spots), dtype=bool)
+    if len(doors):
+        mine = doors[np.abs(doors[:, 2] - floor) < 1.0]
+        if len(mine):
+            near_door = np.linalg.norm(spots[:, None, :2] - mine[None, :, :2],
+                                       axis=2).min(axis=1) < DOOR_BUSY
+    for index in np.flatnonzero((gaps >= clear_of) & ~near_door):
+        spot = spots[index]
+        leg = here + (spot - here) * np.linspace(0.0, 1.0, 6)[:, None]
+        if cosim.fits(robot.id, leg).all() and not segments_hit_boxes(
+                here[None, :], spot[None, :], cosim.world.solid_array)[0]:
+            return spot
+    return None
+
+
+def _on_route(route: FloatArray, xy: FloatArray, velocity: FloatArray) -> tuple[float, float]:
+    """How far along ``route`` a body at ``xy`` (or where it will be in ``LOOK_AHEAD`` s)
+    comes nearest to it, and how near: ``(metres along, metres off)``."""
+    best_along, best_off = math.inf, math.inf
+    for where in (xy, xy + velocity * LOOK_AHEAD):
+        d = np.linalg.norm(route - where, axis=1)
+        i = int(np.argmin(d))
+        if d[i] < best_off:
+            best_along, best_off = i * SAMPLE, float(d[i])
+    return best_along, best_off

@@ -128,6 +128,17 @@ class UavDriver(Avoiding):
             return f"crashed: fell {drop:.1f} m below its course"
         return None
 
+    def fall(self, floor: FloatArray) -> None:
+        """Down on the floor below where it crashed, on its side, its rotors stopped (the
+        fall itself is not simulated: the stepper stops with the motion)."""
+        x, y, _ = self.craft.position()
+        _, quat = self.client.call("getBasePositionAndOrientation", self.body)
+        yaw = self.client.call("getEulerFromQuaternion", quat)[2]
+        self.client.call("resetBasePositionAndOrientation", self.body,
+                         [float(x), float(y), float(floor[2]) + self.spec.radius],
+                         self.client.call("getQuaternionFromEuler", [math.pi / 2, 0.0, yaw]))
+        self.craft.rotor_speed = [0.0] * len(self.craft.rotor_speed)
+
     def recover(self, at: FloatArray) -> None:
         """Set upright over ``at`` (the floor) at its flying height, still, rotors at hover."""
         self.client.call("resetBasePositionAndOrientation", self.body,

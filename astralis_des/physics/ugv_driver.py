@@ -37,6 +37,7 @@ BACK_OFF_SPEED = 0.35  # m/s
 BACK_OFFS = 2  # at most this many per leg; then the stuck test decides
 CRASH_TILT = 45.0  # degrees of roll or pitch: the Husky is on its side
 FALL = 0.5  # m below the floor it drives on: it fell off it
+SUPPORT = 0.7  # a contact normal steeper than this is the floor holding it up
 
 Leg = tuple[bool, FloatArray]  # (a ride on the lift, floor-level points)
 
@@ -71,10 +72,13 @@ class UgvDriver(Avoiding):
 
     # -- what the others see ---------------------------------------------------------------
     def heading_vector(self) -> FloatArray:
+        """The way it is headed along its path (it may first turn to face it)."""
         if self.turning or self.ride is not None or not len(self.husky.path):
             return np.zeros(2)
-        yaw = self.husky.pose()[3]
-        return np.array([math.cos(yaw), math.sin(yaw)]) * self.speed
+        x, y, _, _ = self.husky.pose()
+        gx, gy = self.husky.aim()
+        norm = math.hypot(gx - x, gy - y)
+        return np.array([gx - x, gy - y]) / norm * self.speed if norm > 0.05 else np.zeros(2)
 
     def progress(self) -> float:
         ride = 0.0
@@ -200,14 +204,21 @@ class UgvDriver(Avoiding):
         return None
 
     def _check_blocked(self, t: float) -> None:
-        """No progress for a while, not held: reverse a little and try again."""
+        """No progress for a while, not held, and pressing on something (a wall, furniture,
+        a body): reverse a little and try again."""
         progress = self.progress()
         if progress > self._best[0] + 0.05:
             self._best = (progress, t)
-        elif t - self._best[1] > BACK_OFF_AFTER and self.back_offs < BACK_OFFS:
+        elif t - self._best[1] > BACK_OFF_AFTER and self.back_offs < BACK_OFFS and \
+                self._pressing():
             self.back_offs += 1
             self.backing_until = t + BACK_OFF_TIME
             self._best = (progress, t + BACK_OFF_TIME)
+
+    def _pressing(self) -> bool:
+        """Is the body touching something other than the floor it stands on?"""
+        return any(c[7][2] < SUPPORT for c in self.client.call("getContactPoints",
+                                                                bodyA=self.body))
 
     def _ride(self, t: float) -> str | None:
         lift, z_from, z_to = self.ride  # type: ignore[misc]
@@ -218,7 +229,8 @@ class UgvDriver(Avoiding):
                 min(z_from, z_to) < lift.z < max(z_from, z_to)):
             return None  # the platform is elsewhere: it was called, it is not here yet
         if self.column_busy(lift, self.id):
-            return None  # someone else is in the column: the lift does not move
+            lift.moving = False  # someone else is in the column: the lift waits for it
+            return None
         there = lift.move_towards(z_to, self.speed * self.period)
         x, y, _, yaw = self.husky.pose()
         self.client.call("resetBasePositionAndOrientation", self.body,
@@ -246,7 +258,9 @@ class UgvDriver(Avoiding):
         if not lift.reserve(self.id):
             return not lift.contains(here, WAIT_AT) and lift.contains(here, WAIT_AT + 0.5)
         if abs(lift.z - self.floor) > 1e-6:
-            if not self.column_busy(lift, self.id):
+            if self.column_busy(lift, self.id):
+                lift.moving = False
+            else:
                 lift.move_towards(self.floor, self.speed * self.period)
             return lift.contains(here, WAIT_AT)
         lift.moving = False
@@ -276,6 +290,9 @@ class UgvDriver(Avoiding):
         if drop > FALL:
             return f"crashed: fell {drop:.1f} m"
         return None
+
+    def fall(self, floor: FloatArray) -> None:
+        """A Husky on its side stays as it lies (it is simulated to rest already)."""
 
     def recover(self, at: FloatArray) -> None:
         """Set upright on its wheels at ``at`` (floor level)."""

@@ -25,6 +25,9 @@ if TYPE_CHECKING:
     from astralis_des.planning.occupancy import GridMap, VoxelMap
 
 BODY_RADIUS = {"uav": 0.3, "ugv": 0.35, "human": 0.25}  # m, a disc around the body's centre
+# m more kept from furniture and people than from walls: a UAV cuts a corner of its path by
+# up to a quarter metre (measured), and it should not brush a person's head
+KEEP_OUT = {"uav": 0.2, "ugv": 0.0, "human": 0.0}
 WINDOW = 3.0  # m around a leg that its planner may use
 CELL = 0.1  # m, walkers' floor grid
 
@@ -160,14 +163,17 @@ class Navigator:
 
     def _valid(self, robot: Robot, points: FloatArray, radius: float) -> np.ndarray:
         pts = np.atleast_2d(points)
-        boxes = self._furniture(pts.min(axis=0) - radius, pts.max(axis=0) + radius)
-        return self._checker(boxes, radius)(pts)
+        reach = radius + KEEP_OUT[robot.kind]
+        boxes = self._furniture(pts.min(axis=0) - reach, pts.max(axis=0) + reach)
+        return self._checker(boxes, radius, KEEP_OUT[robot.kind])(pts)
 
-    def _checker(self, boxes: FloatArray, radius: float):  # type: ignore[no-untyped-def]
+    def _checker(self, boxes: FloatArray, radius: float,  # type: ignore[no-untyped-def]
+                 keep_out: float = 0.0):
         """A validity test for many states: the map's clearance, and the furniture ``boxes``
-        grown by ``radius`` (gathered once, not per state: a planner asks thousands)."""
+        grown by ``radius`` and ``keep_out`` (gathered once, not per state: a planner asks
+        thousands)."""
         voxels = self.map
-        grown_lo, grown_hi = boxes[:, 0] - radius, boxes[:, 1] + radius
+        grown_lo, grown_hi = boxes[:, 0] - radius - keep_out, boxes[:, 1] + radius + keep_out
 
         def valid(points: FloatArray) -> np.ndarray:
             pts = np.atleast_2d(points)
@@ -186,10 +192,15 @@ class Navigator:
         a, b = a.copy(), b.copy()
         if robot.kind != "uav":  # a ground body stands on its floor: test at its middle
             a[2] = b[2] = self.world.floor_below(a) + 0.4
-        lo, hi = np.minimum(a, b) - radius, np.maximum(a, b) + radius
-        boxes = np.concatenate([self.world.solid_array, self._furniture(lo, hi)])
-        boxes = boxes[np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1)]
-        grown = np.stack([boxes[:, 0] - radius, boxes[:, 1] + radius], axis=1)
+        keep_out = KEEP_OUT[robot.kind]
+        lo, hi = np.minimum(a, b) - radius - keep_out, np.maximum(a, b) + radius + keep_out
+        furniture = self._furniture(lo, hi)
+        margins = np.concatenate([np.full(len(self.world.solid_array), radius),
+                                  np.full(len(furniture), radius + keep_out)])
+        boxes = np.concatenate([self.world.solid_array, furniture])
+        near = np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1)
+        boxes, margins = boxes[near], margins[near]
+        grown = np.stack([boxes[:, 0] - margins[:, None], boxes[:, 1] + margins[:, None]], axis=1)
         return not bool(segments_hit_boxes(a[None, :], b[None, :], grown)[0])
 
     # -- planning a leg --------------------------------------------------------------------
@@ -204,7 +215,8 @@ class Navigator:
             from astralis_des.planning.ompl_adapter import plan_3d
 
             lo[2], hi[2] = min(a[2], b[2]) - 1.0, max(a[2], b[2]) + 1.0
-            valid = self._checker(self._furniture(lo, hi), radius)
+            valid = self._checker(self._furniture(lo - KEEP_OUT["uav"], hi + KEEP_OUT["uav"]),
+                                  radius, KEEP_OUT["uav"])
             plan = plan_3d(valid, lo, hi, a, b,
                            budget=budget, planner=self.cfg.uav_planner, seed=seed,
                            resolution=0.1)

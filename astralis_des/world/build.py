@@ -16,6 +16,9 @@ from astralis_des.world.model import Building, Door, Room, Segment, Solid, Space
 from astralis_des.world.spec import BuildingSpec, WorldSpec
 from astralis_des.yamlio import LocatedYaml
 
+LIFT_LENGTH = 2.4  # m along x: the vehicle lift's platform (the UGV turns on it)
+LANDING = 1.2  # m at least between the lift's shaft and the corridor, on every floor
+
 
 @dataclass
 class _Parts:
@@ -120,6 +123,10 @@ def _add_building(b: BuildingSpec, parts: _Parts) -> Building:
     y_north = y_hi + depth["north"]
     top = b.floors * h
     yc = (y_lo + y_hi) / 2
+    # the vehicle lift: a shaft as wide as the corridor at the stairwell's far (west) end,
+    # leaving a landing of at least LANDING before the corridor
+    lift_x1 = ox + t / 2 + max(min(LIFT_LENGTH, b.stairwell_width - t - LANDING), 0.5)
+    lift = Box((ox + t / 2, y_lo + t / 2, 0.0), (lift_x1, y_hi - t / 2, top - t))
 
     for floor in range(1, b.floors + 1):
         z = (floor - 1) * h
@@ -153,13 +160,20 @@ def _add_building(b: BuildingSpec, parts: _Parts) -> Building:
         slab_x0 = ox if floor == 1 else x_stair  # the stair shaft is open above the ground
         parts.solids.append(Solid("slab", Box((slab_x0, oy, z - t), (x_east, y_north, z)),
                                   f"{b.id}.{floor} floor"))
+        if floor > 1:  # the landing between the corridor and the lift's shaft
+            parts.solids.append(Solid("slab", Box((lift.hi[0], y_lo, z - t), (x_stair, y_hi, z)),
+                                      f"{b.id}.{floor} landing"))
     parts.solids.append(Solid("slab", Box((ox, oy, top - t), (x_east, y_north, top)),
                               f"{b.id} roof"))
+    for y in (lift.lo[1] - t / 2, lift.hi[1] + t / 2):  # the shaft's sides; open to the landing
+        parts.solids.append(Solid("wall", Box((ox, y - t / 2, 0.0), (lift.hi[0], y + t / 2,
+                                                                      top - t)),
+                                  f"{b.id} lift shaft"))
     parts.spaces[f"{b.id}.stairwell"] = Space(
         f"{b.id}.stairwell", "stairwell", b.id, 0,
         Box((ox + t / 2, oy + t / 2, 0.0), (x_stair - t / 2, y_north - t / 2, top - t)))
     return Building(b.id, Box((ox, oy, 0.0), (x_east, y_north, top)), b.floors, h,
-                    entrance=(x_east + 1.5, yc, 0.0))
+                    entrance=(x_east + 1.5, yc, 0.0), lift=lift)
 
 
 def _floor_walls(

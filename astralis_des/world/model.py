@@ -102,6 +102,7 @@ class Building:
     floors: int
     floor_height: float
     entrance: tuple[float, float, float]  # just outside the entrance door, at ground level
+    lift: Box | None = None  # the vehicle lift's shaft in the stairwell (from the ground up)
 
 
 @dataclass(frozen=True)
@@ -144,12 +145,14 @@ class World:
 
     @cached_property
     def doorways(self) -> FloatArray:
-        """``(N, 3)`` centres (at floor height) of the openings in walls a robot passes
-        through: each room's door and each building's entrance."""
-        doors = [r.door.center for r in self.rooms.values() if r.building in self.buildings]
-        doors += [(b.footprint.hi[0], b.entrance[1], b.footprint.lo[2])
+        """``(N, 4)``: the centre (at floor height) of each opening in a wall that a robot
+        passes through (each room's door, each building's entrance) and the axis its wall is
+        normal to (0: x, 1: y)."""
+        doors = [(*r.door.center, r.door.normal_axis) for r in self.rooms.values()
+                 if r.building in self.buildings]
+        doors += [(b.footprint.hi[0], b.entrance[1], b.footprint.lo[2], 0)
                   for b in self.buildings.values()]
-        return np.array(doors, dtype=float).reshape(-1, 3)
+        return np.array(doors, dtype=float).reshape(-1, 4)
 
     @cached_property
     def router(self) -> Router:

@@ -90,19 +90,28 @@ class Router:
                 self._edge(door, nodes[xs.index(room.door.center[0])])
         for b in w.buildings.values():
             stair = w.spaces[f"{b.id}.stairwell"].box
-            sx = (stair.lo[0] + stair.hi[0]) / 2
+            # the landing, between the lift's shaft and the corridor: where every kind enters
+            west = b.lift.hi[0] if b.lift is not None else stair.lo[0]
+            sx = (west + stair.hi[0]) / 2
             passable = w.stairs_passable_by.get(b.id, KINDS)
             previous = None
             for floor in range(1, b.floors + 1):
                 corridor = self.corridor_nodes[f"{b.id}.{floor}.corridor"]
                 z = (floor - 1) * b.floor_height
-                node = self._node(f"{b.id}.{floor}.stair", (sx, self._pos[corridor[0]][1], z))
+                yc = self._pos[corridor[0]][1]
+                node = self._node(f"{b.id}.{floor}.stair", (sx, yc, z))
                 self._edge(node, corridor[0])
-                if previous is not None:
-                    self._stairs(previous, node, stair.hi[1] - 0.5, passable)
+                if previous is not None:  # a UGV takes the lift where there is one
+                    self._stairs(previous, node, stair.hi[1] - 0.5, tuple(
+                        k for k in passable if k != "uav" and (k != "ugv" or b.lift is None)))
+                if "ugv" in passable and b.lift is not None:  # onto the lift's platform
+                    lift = self._node(f"{b.id}.{floor}.lift", (*b.lift.center[:2], z))
+                    self._edge(node, lift, ("ugv",))
+                    if floor > 1:
+                        self._edge(self.index[f"{b.id}.{floor - 1}.lift"], lift, ("ugv",))
                 if "uav" in passable:  # UAVs rise and sink at the far end, clear of the lift
-                    y_well = max(stair.hi[1] - UAV_WELL, self._pos[node][1])
-                    well = self._node(f"{b.id}.{floor}.well", (sx, y_well, z))
+                    well = self._node(f"{b.id}.{floor}.well",
+                                      (sx, max(stair.hi[1] - UAV_WELL, yc), z))
                     self._edge(node, well, ("uav",))
                     if floor > 1:
                         self._edge(self.index[f"{b.id}.{floor - 1}.well"], well, ("uav",))
@@ -131,16 +140,13 @@ class Router:
             for b_idx in others[clear]:
                 self._edge(self.outdoor_nodes[a], self.outdoor_nodes[b_idx])
 
-    def _stairs(self, lower: int, upper: int, y_max: float, passable: tuple[str, ...]) -> None:
-        """Between two floors of a stairwell: the UGV rides the vehicle lift straight up from
-        the landing (the stair node, by the corridor); walkers take a switchback flight whose
-        mid-landing makes the route as long as the stairs (run = 2 x rise). (UAVs rise in the
-        open well at the far end: ``_build``.)"""
+    def _stairs(self, lower: int, upper: int, y_max: float, walkers: tuple[str, ...]) -> None:
+        """Between two floors of a stairwell, from its landing (the stair node, by the
+        corridor): ``walkers`` take a switchback flight whose mid-landing makes the route as
+        long as the stairs (run = 2 x rise). (The UGV rides the lift in its shaft, UAVs rise
+        in the open well at the far end: ``_build``.)"""
         x, y, z0 = self._pos[lower]
         rise = self._pos[upper][2] - z0
-        if "ugv" in passable:
-            self._edge(lower, upper, ("ugv",))
-        walkers = tuple(k for k in passable if k not in ("uav", "ugv"))
         if walkers:
             run = STAIR_RUN_FACTOR * rise / 2
             mid = self._node(f"{self.names[lower]}:flight",
@@ -202,7 +208,11 @@ class Router:
         if place.endswith(".stairwell"):
             b = self.world.buildings[place.split(".")[0]]
             floor = min(b.floors, max(1, int(p[2] // b.floor_height) + 1))
-            return [self.index[f"{b.id}.{floor}.stair"]]
+            on_lift = f"{b.id}.{floor}.lift"
+            stair = [self.index[f"{b.id}.{floor}.stair"]]
+            if b.lift is not None and on_lift in self.index and b.lift.contains(p):
+                return [self.index[on_lift], *stair]  # on the platform
+            return stair
         nodes = np.array(self.outdoor_nodes)
         pts = self.positions[nodes]
         clear = self._outdoor_clear(np.repeat(p[None, :], len(pts), 0), pts)
