@@ -18,6 +18,7 @@ from astralis_des.world.model import Room, World
 
 DOOR_OFFSET = 0.6  # m in front of a door's wall: where robots stop by a door
 TURN_MARGIN = 0.1  # m kept between a wall and the circle a body sweeps turning on the spot
+LOOK_AROUND = 2.0  # s spent looking round a room that cannot be searched by its pattern
 ActionGen = Generator[simpy.Event, Any, ActionResult]
 StepGen = Generator[simpy.Event, Any, float]
 
@@ -122,10 +123,14 @@ def search_path(ctx: Context, robot: Robot, room: Room, plan: FloatArray, label:
     pattern = at_height(robot, plan)
     sweep = ctx.navigator.usable(robot, pattern)  # where the body fits among the furniture
     if len(sweep) == 0:
-        return failed(f"{label}: no point of the pattern is free in {room.id}")
-    approach = route(ctx, robot, sweep[0] - np.array([0.0, 0.0, robot.height]))
+        return (yield from _from_the_door(ctx, robot, room, label))
+    for entry in range(len(sweep)):  # the first point it can get to starts the pattern
+        approach = route(ctx, robot, sweep[entry] - np.array([0.0, 0.0, robot.height]))
+        if approach.points is not None:
+            break
     if approach.points is None:
         return failed(approach.reason)
+    sweep = sweep[entry:]
     distance = yield from traverse(ctx, robot, approach.points, sense=False)
     skipped = len(pattern) - len(sweep)
     if ctx.navigator.method == "map":  # unreachable points are left out, not the search
@@ -137,6 +142,25 @@ def search_path(ctx: Context, robot: Robot, room: Room, plan: FloatArray, label:
     distance += yield from traverse(ctx, robot, sweep, sense=True)
     return result(TaskStatus.SUCCEEDED, f"{label} saw {coverage:.0%} of {room.id}{note}",
                   distance=distance, coverage=coverage, extra={"skipped": skipped})
+
+
+def _from_the_door(ctx: Context, robot: Robot, room: Room, label: str) -> ActionGen:
+    """A pattern with no point the body fits at (a crammed room): look around from just
+    inside the door instead, and say so."""
+    inside = at_height(robot, np.array([room.door_point("room", DOOR_OFFSET)]))
+    if not len(ctx.navigator.usable(robot, inside)):
+        return failed(f"{label}: no point of the pattern is free in {room.id}, nor the door")
+    way = route(ctx, robot, inside[0] - np.array([0.0, 0.0, robot.height]))
+    if way.points is None:
+        return failed(way.reason)
+    distance = yield from traverse(ctx, robot, way.points, sense=False)
+    yield from dwell(ctx, robot, LOOK_AROUND)
+    headings = np.linspace(0.0, 2 * np.pi, 8, endpoint=False)
+    coverage = ctx.sensor.coverage(robot, np.repeat(inside, len(headings), axis=0), room,
+                                   headings=headings)
+    return result(TaskStatus.SUCCEEDED, f"{label}: no point of the pattern is free in "
+                  f"{room.id}; looked round from the door, saw {coverage:.0%}",
+                  distance=distance, coverage=coverage)
 
 
 def stand_off(robot: Robot, least: float = DOOR_OFFSET) -> float:

@@ -46,6 +46,7 @@ SUPPORT = 0.7  # a contact normal steeper than this holds a ground robot up: not
 FLOORS = ("wall", "ground", "lift")  # what holds a ground robot up (slabs are static boxes)
 CAP_FACTOR, CAP_SLACK = 2.0, 30.0  # a motion planned to take T s fails after 2 T + 30 s
 TURN_CAP = 30.0  # s: a turn on the spot that takes longer has failed
+RISE_AHEAD = 1.0  # s: a waiting UAV that a walking avatar reaches this soon has risen over it
 
 
 @dataclass
@@ -105,6 +106,7 @@ class PhysicsCoSim:
                 driver.column_busy = self._column_busy
             if isinstance(driver, HumanDriver):
                 driver.bodies_near = self._bodies_near(rid)
+                driver.robot_of = {d.body: other for other, d in self.drivers.items()}
         self._scene = sim.scene
         self.robots = sim.robots
         self._navigator = sim.navigator
@@ -206,9 +208,34 @@ class PhysicsCoSim:
     # -- the co-simulation contract ------------------------------------------------------
     def execute(self, robot: Robot, motion: Motion) -> simpy.Event:
         self.halt(robot)
+        if robot.kind == "uav":
+            motion = self._clear_of_movers(robot, motion)
         motion.t0 = self.env.now
         self.drivers[robot.id].start(motion, self.env.now)
         return self._activate(robot, CAP_FACTOR * motion.duration + CAP_SLACK)
+
+    def _clear_of_movers(self, robot: Robot, motion: Motion) -> Motion:
+        """A UAV about to move that a walking avatar has reached while it waited (it was not
+        simulated then) has risen over the avatar's head, as it would have, had it been:
+        its motion starts up there."""
+        here = self.drivers[robot.id].position()
+        soon = self.env.now + np.linspace(0.0, RISE_AHEAD, 5)
+        for mover, _ in self.movers:
+            centres = mover.positions_at(soon)
+            half = np.asarray(mover.size) / 2 + np.array([0.35, 0.35, 0.1])
+            if np.all(np.abs(here - centres) <= half, axis=1).any():
+                centre = centres[0]
+                up = np.array([here[0], here[1], centre[2] + mover.size[2] / 2 + 0.35])
+                if not self.fits(robot.id, up[None, :]).all():
+                    continue
+                self.client.call("resetBasePositionAndOrientation", self.drivers[robot.id].body,
+                                 up.tolist(), [0.0, 0.0, 0.0, 1.0])
+                self.log.emit("make_way", robot.id, for_robot=mover.id, to=up)
+                points = np.vstack([up, motion.points[1:]]) if len(motion.points) > 1 else \
+                    up[None, :]
+                return Motion(points, motion.speed, accel=motion.accel,
+                              turn_rate=motion.turn_rate, heading=motion.heading)
+        return motion
 
     def face(self, robot: Robot, heading: float) -> simpy.Event:
         """Turn on the spot to ``heading``: the UGV turns its body; others look at once."""

@@ -94,6 +94,8 @@ class HumanDriver(Avoiding):
         # the bodies of the robots near a point (set by the co-simulation): a walker is
         # placed, not pushed, so it must not step into one of them
         self.bodies_near: Callable[[FloatArray], list[int]] = lambda point: []
+        self.robot_of: dict[int, str] = {}  # body -> robot id, for the bodies above
+        self.blocked_by: tuple[str, ...] = ()  # the robots it last had to wait for
         self._clear_avoidance()
 
     def start(self, motion: Motion, t: float) -> None:
@@ -130,9 +132,11 @@ class HumanDriver(Avoiding):
         depth = self._overlap(near)
         self.walker.place(where)
         self.placed = where
+        self.blocked_by = ()
         if near and self._overlap(near) > depth + 1e-4:  # it would step into a robot: wait
             self.elapsed, self.shift, self.placed = before
             self.walker.place(self.placed)
+            self.blocked_by = tuple(self.robot_of.get(b, "") for b in near)
         if self.elapsed >= self.motion.duration:
             return "arrived"
         remaining = self.motion.length - self.progress()

@@ -43,7 +43,7 @@ SHIFT = 0.7  # m to the right at most
 STOP_RANGE = 0.8  # m between bodies' edges ahead: hold
 LANE_MARGIN = 0.15  # m added to the two radii to decide "in my lane"
 HEIGHTS = {"uav": (-0.1, 0.1), "ugv": (-0.5, 0.15), "human": (-1.6, 0.15)}  # around the pose
-RADII = {"uav": 0.3, "ugv": 0.5, "human": 0.25}
+RADII = {"uav": 0.3, "ugv": 0.62, "human": 0.25}  # the UGV: its half-diagonal
 STILL_RANK = 10_000  # movers, the lift, and robots not moving: everyone yields to them
 NEAR = 6.0  # m: movers farther than this from every moving robot need not move in physics
 RATE = 5.0  # Hz: how often the layer decides (a UAV flies 0.3 m in between)
@@ -54,6 +54,7 @@ DOOR_ON_PATH = 0.4  # m: a path passing this near a doorway's centre goes throug
 DOOR_BUSY = 1.0  # m: a body this near a doorway is in it; the others wait
 GOAL_TAKEN = 2.8  # m: a goal another body stands still on is reached this near
 CLIMB_MARGIN = 0.3  # m a climbing UAV keeps above a walker's head
+MAX_CLIMB = 0.8  # m: a UAV climbs at most this far above its course
 CLIMB_SOON = 3.0  # s: a walker this close to meeting a UAV makes it climb
 WALKERS = ("human", "avatar")
 SHARES = (1.0, 2 / 3, 1 / 3)  # of a keep-right shift, tried in turn
@@ -83,6 +84,7 @@ class LocalLayer:
         self.near: list[int] = []  # movers within NEAR of a moving robot: the ones to move
         # robots standing in another's way: who asks them to make way, and its path ahead
         self.requests: dict[str, tuple[str, FloatArray]] = {}
+        self._deciding = ""  # the robot whose moves are being decided
         self.solids = cosim.world.solid_array
         self.doors = cosim.world.doorways
 
@@ -134,6 +136,7 @@ class LocalLayer:
     def _decide_for(self, rid: str, me: Body, bodies: list[Body], where: FloatArray,
                     ahead: FloatArray, doors: dict[str, int | None]) -> None:
         driver = self.cosim.drivers[rid]
+        self._deciding = rid
         direction = driver.heading_vector()
         speed = float(np.linalg.norm(direction))
         if speed < 1e-6:
@@ -155,51 +158,53 @@ class LocalLayer:
             blockers.append(in_door)
         occupant = self._goal_taken(driver, me, others)
         driver.arrive_within = GOAL_TAKEN if occupant is not None else 0.2
-        for other in [*blockers, *([occupant] if occupant else [])]:
+        pressing = [b for b in others if b.name in getattr(driver, "blocked_by", ())]
+        for other in [*blockers, *([occupant] if occupant else []), *pressing]:
             if other.name in self.cosim.drivers and other.name not in self.cosim.active and \
                     self.cosim.may_ask(other.name):
                 self.requests.setdefault(other.name, (rid, driver.path_ahead(MAKE_WAY_PATH)))
         in_doorway = self._by_doorway(me.xy, me.base_z[0])
         open_space = door is None and not in_doorway
-        climb = self._climb(me, others) if me.kind == "uav" and not in_doorway else 0.0
-        hold = hold or climb > 0.0  # it waits above the walker until it has passed below
-        if shift and open_space:
-            shift = self._clear_shift(me, ahead, right, shift, (1.0,) if aside else SHARES)
-        elif shift:
-            shift = 0.0
+        climb, wait = self._climb(me, others, direction) if me.kind == "uav" and \
+            not in_doorway else (0.0, False)
+        hold = hold or wait
+        if shift.any() and open_space:
+            shift = self._clear_shift(ahead, shift, (1.0,) if aside else SHARES)
+        else:
+            shift = np.zeros(2)
         self.holds += hold
-        self.shifts += bool(shift)
+        self.shifts += bool(shift.any())
         self.climbs += bool(climb)
-        driver.avoid(hold, right * shift, climb)
+        driver.avoid(hold, shift, climb)
 
     def _decide(self, me: Body, others: list[Body], forward: FloatArray, right: FloatArray,
-                speed: float, route: FloatArray) -> tuple[bool, float, bool, list[Body]]:
-        """Hold or not, the shift to the right off the path (left if negative), whether that
-        shift steps round something standing still (all of it, or no use), and the bodies
-        the robot holds for. ``route``: where the robot will be over the next metres (its
-        path ahead, as shifted now), ``SAMPLE`` apart."""
-        hold, shift, aside = False, 0.0, False
+                speed: float, route: FloatArray) -> tuple[bool, FloatArray, bool, list[Body]]:
+        """Hold or not; the shift off the path (a vector in the plane: keep right, or step
+        round something standing still); whether that shift steps round something (all of
+        it, or no use); and the bodies the robot holds for. ``route``: where the robot will
+        be over the next metres (its path ahead, as shifted now), ``SAMPLE`` apart."""
+        hold, shift, aside = False, np.zeros(2), False
         blockers: list[Body] = []
         stop = STOP_RANGE + BRAKING * speed
+        path = route - me.offset  # the path itself, unshifted
         for other in others:
             if other.z[1] < me.z[0] or other.z[0] > me.z[1]:
                 continue  # above or below it (a UAV over the UGV)
             rel = other.xy - me.xy
             along, across = float(rel @ forward), float(rel @ right)
-            from_path = across + float(me.offset @ right)  # across, from the unshifted path
             gap = math.hypot(along, across) - me.radius - other.radius
             lane = me.radius + other.radius + LANE_MARGIN
             if gap > PASS_RANGE:
                 continue
             reach, off_route = _on_route(route, other.xy, other.velocity)
             if along > 0 and off_route < lane + SHIFT:
-                if float(other.velocity @ forward) < -0.05:
-                    if abs(from_path) < lane + SHIFT:  # it comes towards us, close: keep right
-                        shift, aside = max(shift, SHIFT), False
-                elif float(np.linalg.norm(other.velocity)) < 0.05 and abs(from_path) < lane:
-                    # standing in our lane: pass it on the side away from it, clear of it
-                    side = from_path - lane - 0.05 if from_path >= 0 else from_path + lane + 0.05
-                    if abs(side) > abs(shift):
+                if float(other.velocity @ forward) < -0.05:  # coming towards us: keep right
+                    if not aside and abs(across + float(me.offset @ right)) < lane + SHIFT:
+                        shift = right * SHIFT
+                elif float(np.linalg.norm(other.velocity)) < 0.05:
+                    side = _round(path, other.xy, lane + 0.05)  # standing on our way
+                    if side is not None and float(np.linalg.norm(side)) > \
+                            float(np.linalg.norm(shift)):
                         shift, aside = side, True
             ahead = along > 0 and reach - me.radius - other.radius < stop and off_route < lane
             # hold for a body of higher priority ahead, and for any ahead going our way (it
@@ -221,13 +226,14 @@ class LocalLayer:
         hidden = segments_hit_boxes(a, b, self.solids)
         return [o for o, h in zip(others, hidden, strict=True) if o.kind == "lift" or not h]
 
-    def _clear_shift(self, me: Body, ahead: FloatArray, right: FloatArray, shift: float,
-                     shares: tuple[float, ...]) -> float:
-        """The largest share of ``shift`` that keeps the path ahead clear, or 0."""
-        points = np.concatenate([ahead + np.array([*(right * (shift * share)), 0.0])
+    def _clear_shift(self, ahead: FloatArray, shift: FloatArray,
+                     shares: tuple[float, ...]) -> FloatArray:
+        """The largest share of ``shift`` that keeps the path ahead clear, or none."""
+        rid = self._deciding
+        points = np.concatenate([ahead + np.array([*(shift * share), 0.0])
                                  for share in shares])  # from the robot's unshifted place on
-        fits = self.cosim.fits(me.name, points).reshape(len(shares), len(ahead)).all(axis=1)
-        return shift * shares[int(np.argmax(fits))] if fits.any() else 0.0
+        fits = self.cosim.fits(rid, points).reshape(len(shares), len(ahead)).all(axis=1)
+        return shift * shares[int(np.argmax(fits))] if fits.any() else np.zeros(2)
 
     # -- doorways ----------------------------------------------------------------------------
     def _doors_on(self, floor_z: float) -> FloatArray:
@@ -288,22 +294,24 @@ class LocalLayer:
                 return other
         return None
 
-    def _climb(self, me: Body, others: list[Body]) -> float:
-        """How far a UAV climbs (where it is) to let a walker on a collision course with it
-        pass below."""
-        need = 0.0
+    def _climb(self, me: Body, others: list[Body], velocity: FloatArray) -> tuple[float, bool]:
+        """How far a UAV going at ``velocity`` climbs (where it is) to pass over a walker
+        on a collision course with it, and whether it waits up there: for a walker that
+        moves, until it has passed below; over one standing still it flies on."""
+        need, wait = 0.0, False
         for other in others:
             if other.kind not in WALKERS or other.z[1] < me.base_z[0]:
                 continue
-            miss = _closest_approach(other.xy - me.xy, other.velocity - me.velocity,
-                                     CLIMB_SOON)
+            miss = _closest_approach(other.xy - me.xy, other.velocity - velocity, CLIMB_SOON)
             if miss < me.radius + other.radius + 0.3:
                 need = max(need, other.z[1] + CLIMB_MARGIN - me.base_z[0])
+                wait = wait or float(np.linalg.norm(other.velocity)) > 0.05
+        need = min(need, MAX_CLIMB)
         if need <= 0.0:
-            return 0.0
+            return 0.0, False
         centre = (me.base_z[0] + me.base_z[1]) / 2
         above = np.array([[*me.xy, centre + need]])
-        return need if self.cosim.fits(me.name, above).all() else 0.0
+        return (need, wait) if self.cosim.fits(me.name, above).all() else (0.0, False)
 
 
 def _closest_approach(rel: FloatArray, velocity: FloatArray, horizon: float) -> float:
@@ -356,3 +364,22 @@ def _on_route(route: FloatArray, xy: FloatArray, velocity: FloatArray) -> tuple[
         if d[i] < best_off:
             best_along, best_off = i * SAMPLE, float(d[i])
     return best_along, best_off
+
+
+def _round(path: FloatArray, xy: FloatArray, clear: float) -> FloatArray | None:
+    """The shift off ``path`` (a vector) that passes a body standing at ``xy`` ``clear`` away
+    on the side away from it, measured where the path comes nearest to it; None when the
+    path passes it by that far already."""
+    d = np.linalg.norm(path - xy, axis=1)
+    i = int(np.argmin(d))
+    if d[i] >= clear:
+        return None
+    j = min(i + 1, len(path) - 1)
+    tangent = path[j] - path[j - 1] if j > 0 else np.array([1.0, 0.0])
+    norm = float(np.linalg.norm(tangent))
+    if norm < 1e-9:
+        return None
+    normal = np.array([tangent[1], -tangent[0]]) / norm
+    offset = float((xy - path[i]) @ normal)  # where it stands, across the path
+    side = offset - clear if offset >= 0 else offset + clear
+    return normal * side

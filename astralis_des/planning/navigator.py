@@ -245,8 +245,12 @@ class Navigator:
         return np.column_stack([xy, np.full(len(xy), a[2])]), ""
 
     def _floor_grid(self, lo: FloatArray, hi: FloatArray, floor: float) -> GridMap:
-        """What stands on the floor (walls, furniture, avatars) between ``lo`` and ``hi``."""
+        """What stands on the floor (walls, furniture, avatars) between ``lo`` and ``hi``. The
+        grid is aligned to one lattice of ``CELL`` for the whole world, so that a point is in
+        the same cell, free or not, whichever window it is looked at in."""
         from astralis_des.planning.occupancy import GridMap
+
+        lo = np.floor(np.asarray(lo, dtype=float) / CELL) * CELL
 
         shape = np.maximum(np.ceil((hi - lo) / CELL).astype(int), 1)
         centers = lo + (np.indices(shape).reshape(2, -1).T + 0.5) * CELL

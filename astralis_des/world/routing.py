@@ -102,7 +102,7 @@ class Router:
                 node = self._node(f"{b.id}.{floor}.stair", (sx, yc, z))
                 self._edge(node, corridor[0])
                 if previous is not None:  # a UGV takes the lift where there is one
-                    self._stairs(previous, node, stair.hi[1] - 0.5, tuple(
+                    self._stairs(previous, node, stair.lo[1] + 0.5, tuple(
                         k for k in passable if k != "uav" and (k != "ugv" or b.lift is None)))
                 if "ugv" in passable and b.lift is not None:  # onto the lift's platform
                     lift = self._node(f"{b.id}.{floor}.lift", (*b.lift.center[:2], z))
@@ -140,17 +140,18 @@ class Router:
             for b_idx in others[clear]:
                 self._edge(self.outdoor_nodes[a], self.outdoor_nodes[b_idx])
 
-    def _stairs(self, lower: int, upper: int, y_max: float, walkers: tuple[str, ...]) -> None:
+    def _stairs(self, lower: int, upper: int, y_min: float, walkers: tuple[str, ...]) -> None:
         """Between two floors of a stairwell, from its landing (the stair node, by the
-        corridor): ``walkers`` take a switchback flight whose mid-landing makes the route as
-        long as the stairs (run = 2 x rise). (The UGV rides the lift in its shaft, UAVs rise
-        in the open well at the far end: ``_build``.)"""
+        corridor): ``walkers`` take a switchback flight south of the landing, whose
+        mid-landing makes the route as long as the stairs (run = 2 x rise). (The UGV rides
+        the lift in its shaft west of the landing, UAVs rise in the open well at the north
+        end: ``_build``.)"""
         x, y, z0 = self._pos[lower]
         rise = self._pos[upper][2] - z0
         if walkers:
             run = STAIR_RUN_FACTOR * rise / 2
             mid = self._node(f"{self.names[lower]}:flight",
-                             (x, min(y + run, y_max), z0 + rise / 2))
+                             (x, max(y - run, y_min), z0 + rise / 2))
             self._edge(lower, mid, walkers)
             self._edge(mid, upper, walkers)
 
