@@ -54,7 +54,7 @@ def test_a_sneak_peek_at_every_door_of_building_a_touches_no_wall() -> None:
     base = load_mission(MISSIONS / "fig7.yaml")
     sim = Simulation(base.with_changes(
         fidelity="physics", team=[{"id": "ugv1", "kind": "ugv", "start": [70.0, 78.25, 0.0]}],
-        scene={"clutter": False}, time_limit=5000,
+        scene={"clutter": False}, time_limit=5000, target={"room": "B.1.1.1"},
         assignment={**base.spec.assignment.model_dump(), "start_at": 4000.0}))
     robot = sim.robots["ugv1"]
     assert stand_off(robot, 0.5) > 0.61 + 0.05  # the Husky's half-diagonal, and a margin

@@ -3,6 +3,8 @@ change floors at the stairwell's far end, clear of it."""
 
 from __future__ import annotations
 
+import itertools
+
 from pathlib import Path
 
 import numpy as np
@@ -75,7 +77,7 @@ def test_uavs_change_floors_in_the_well_clear_of_the_lift_column() -> None:
     way = world.router.route(np.array([70.0, CORRIDOR_Y, 0.0]),
                              np.array(world.rooms["A.3.1.2"].door_point("corridor")), "uav")
     assert way is not None
-    rising = [(a, b) for a, b in zip(way[:-1], way[1:], strict=True) if abs(b[2] - a[2]) > 0.3]
+    rising = [(a, b) for a, b in itertools.pairwise(way) if abs(b[2] - a[2]) > 0.3]
     assert rising
     sim = lone("uav", [70.0, CORRIDOR_Y, 0.0])
     lift = sim.cosim.lifts[0]

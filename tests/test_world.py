@@ -67,15 +67,34 @@ def test_routes_never_cross_a_wall(world: World, kind: str) -> None:
 
 
 def test_routes_upstairs_climb_the_stairwell(world: World) -> None:
-    """Walking to the third floor climbs two flights of stairs; a UAV rises straight up."""
+    """Walking to the third floor climbs two switchback flights (each a run of twice its
+    3.5 m rise, out and back); a UAV rises straight up at the stairwell's north end; the UGV
+    rides the lift straight up in its shaft. The three never share the way between floors."""
     goal = world.rooms["A.3.1.2"].center
-    walk = world.router.route((20.0, 20.0, 0.0), goal, "human")
-    fly = world.router.route((20.0, 20.0, 0.0), goal, "uav")
-    assert walk is not None and fly is not None
-    assert {0.0, 3.5, 7.0} <= set(np.round(walk[:, 2], 3))
-    length = lambda p: float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())  # noqa: E731
-    # Two flights of stairs, each with a run of twice its 3.5 m rise, against two straight climbs.
-    assert length(walk) - length(fly) == pytest.approx(2 * (np.hypot(3.5, 7.0) - 3.5))
+    routes = {kind: world.router.route((20.0, 20.0, 0.0), goal, kind)
+              for kind in ("human", "uav", "ugv")}
+    assert all(r is not None for r in routes.values())
+    for route in routes.values():
+        assert {0.0, 3.5, 7.0} <= set(np.round(route[:, 2], 3))  # type: ignore[index]
+
+    def climbing(route: np.ndarray) -> np.ndarray:
+        legs = np.diff(route, axis=0)
+        return np.flatnonzero(np.abs(legs[:, 2]) > 1e-9)
+
+    walk, fly, drive = routes["human"], routes["uav"], routes["ugv"]
+    flights = np.diff(walk, axis=0)[climbing(walk)]  # type: ignore[arg-type]
+    assert len(flights) == 4
+    assert np.allclose(np.abs(flights[:, 1]), 3.5) and np.allclose(flights[:, 2], 1.75)
+    for route in (fly, drive):  # straight up: no horizontal motion while climbing
+        legs = np.diff(route, axis=0)[climbing(route)]  # type: ignore[arg-type]
+        assert len(legs) == 2 and np.allclose(legs[:, :2], 0.0)
+    shaft = world.buildings["A"].lift
+    assert shaft is not None
+    assert all(shaft.contains(drive[i]) for i in climbing(drive))  # type: ignore[index]
+    uav_xy = fly[climbing(fly)][:, :2]  # type: ignore[index]
+    assert not any(shaft.contains((*xy, 1.0), 0.5) for xy in uav_xy)
+    walker_xy = walk[climbing(walk)][:, :2]  # type: ignore[index]
+    assert np.linalg.norm(uav_xy[:, None] - walker_xy[None], axis=2).min() > 2.0
 
 
 def test_points_inside_walls_or_outside_the_site_are_refused(world: World) -> None:

@@ -11,7 +11,8 @@ an avatar in the next room is no reason to move. The rules, as people keep to in
   order); scripted movers, the lift and robots standing still never yield, so robots do; and
   a robot keeps its distance behind one going its way;
 - doorways are taken in turn: a robot with a doorway on its path ahead waits while another
-  body is in it, or while a robot of higher priority is about to cross it;
+  body is in it, or while a robot of higher priority is about to cross it; a robot waiting
+  for another that comes its way steps off that one's route, where there is room;
 - step aside: something standing still in the lane is passed on the side with room;
 - a UAV on a walker's (a person's, an avatar's) collision course climbs and waits above it
   until it has passed below;
@@ -44,6 +45,7 @@ STOP_RANGE = 0.8  # m between bodies' edges ahead: hold
 LANE_MARGIN = 0.15  # m added to the two radii to decide "in my lane"
 HEIGHTS = {"uav": (-0.1, 0.1), "ugv": (-0.5, 0.15), "human": (-1.6, 0.15)}  # around the pose
 RADII = {"uav": 0.3, "ugv": 0.62, "human": 0.25}  # the UGV: its half-diagonal
+HALF_WIDTHS = {"ugv": 0.4}  # beside it: the Husky's half-width and a margin for its turning
 STILL_RANK = 10_000  # movers, the lift, and robots not moving: everyone yields to them
 NEAR = 6.0  # m: movers farther than this from every moving robot need not move in physics
 RATE = 5.0  # Hz: how often the layer decides (a UAV flies 0.3 m in between)
@@ -68,10 +70,14 @@ class Body:
     xy: FloatArray
     velocity: FloatArray  # xy: zero while it holds
     z: tuple[float, float]
-    radius: float
+    radius: float  # how far it reaches ahead and behind (a disc round it)
     rank: int  # lower yields to higher; movers rank above every robot
     base_z: tuple[float, float] = (0.0, 0.0)  # a UAV's band before any climb
     offset: FloatArray = field(default_factory=lambda: np.zeros(2))  # its shift off its path
+    half_width: float = 0.0  # how far it reaches to the side (a long body's less than radius)
+
+    def __post_init__(self) -> None:
+        self.half_width = self.half_width or self.radius
 
 
 class LocalLayer:
@@ -85,6 +91,7 @@ class LocalLayer:
         # robots standing in another's way: who asks them to make way, and its path ahead
         self.requests: dict[str, tuple[str, FloatArray]] = {}
         self._deciding = ""  # the robot whose moves are being decided
+        self._paths: dict[str, FloatArray] = {}  # where each moving robot will be, xy
         self.solids = cosim.world.solid_array
         self.doors = cosim.world.doorways
 
@@ -98,10 +105,11 @@ class LocalLayer:
             velocity = driver.heading_vector() if active and not driver.held else np.zeros(2)
             # a robot that is not moving cannot yield: it ranks with the movers
             rank = self.rank[rid] if active else STILL_RANK
-            course = driver.course_z() if hasattr(driver, "course_z") else here[2]
+            course = driver.course_z() if active and hasattr(driver, "course_z") else here[2]
             found.append(Body(rid, robot.kind, here[:2], velocity,
                               (here[2] + low, here[2] + high), RADII[robot.kind], rank,
-                              (course + low, course + high), driver.shift))
+                              (course + low, course + high), driver.shift,
+                              HALF_WIDTHS.get(robot.kind, 0.0)))
         for mover, _ in self.cosim.movers:
             here = mover.position_at(t)
             ahead = mover.position_at(t + 0.5)
@@ -130,6 +138,7 @@ class LocalLayer:
         by_name = {b.name: b for b in bodies}
         paths = {rid: self.cosim.drivers[rid].path_ahead(PATH_AHEAD) for rid in self.cosim.active}
         doors = {rid: self._door_ahead(by_name[rid], path) for rid, path in paths.items()}
+        self._paths = {rid: path[:, :2] + by_name[rid].offset for rid, path in paths.items()}
         for rid in self.cosim.active:
             self._decide_for(rid, by_name[rid], bodies, where, paths[rid], doors)
 
@@ -166,12 +175,14 @@ class LocalLayer:
         in_doorway = self._by_doorway(me.xy, me.base_z[0])
         open_space = door is None and not in_doorway
         climb, wait = self._climb(me, others, direction) if me.kind == "uav" and \
-            not in_doorway else (0.0, False)
+            open_space else (0.0, False)  # not under a door's lintel, nor about to be
         hold = hold or wait
         if shift.any() and open_space:
             shift = self._clear_shift(ahead, shift, (1.0,) if aside else SHARES)
         else:
             shift = np.zeros(2)
+        if hold:  # waiting for a robot that comes this way: out of its way too
+            shift = self._yield(me, blockers, ahead, shift)
         self.holds += hold
         self.shifts += bool(shift.any())
         self.climbs += bool(climb)
@@ -193,7 +204,7 @@ class LocalLayer:
             rel = other.xy - me.xy
             along, across = float(rel @ forward), float(rel @ right)
             gap = math.hypot(along, across) - me.radius - other.radius
-            lane = me.radius + other.radius + LANE_MARGIN
+            lane = me.half_width + other.half_width + LANE_MARGIN
             if gap > PASS_RANGE:
                 continue
             reach, off_route = _on_route(route, other.xy, other.velocity)
@@ -202,7 +213,7 @@ class LocalLayer:
                     if not aside and abs(across + float(me.offset @ right)) < lane + SHIFT:
                         shift = right * SHIFT
                 elif float(np.linalg.norm(other.velocity)) < 0.05:
-                    side = _round(path, other.xy, lane + 0.05)  # standing on our way
+                    side = _round(path, other.xy, lane)  # standing on our way
                     if side is not None and float(np.linalg.norm(side)) > \
                             float(np.linalg.norm(shift)):
                         shift, aside = side, True
@@ -234,6 +245,33 @@ class LocalLayer:
                                  for share in shares])  # from the robot's unshifted place on
         fits = self.cosim.fits(rid, points).reshape(len(shares), len(ahead)).all(axis=1)
         return shift * shares[int(np.argmax(fits))] if fits.any() else np.zeros(2)
+
+    def _yield(self, me: Body, blockers: list[Body], ahead: FloatArray,
+               shift: FloatArray) -> FloatArray:
+        """The shift that takes a robot waiting for others off the routes of those coming
+        its way (if the spot is free), else ``shift``."""
+        best = shift
+        for other in blockers:
+            route = self._paths.get(other.name)
+            if route is None or float(np.linalg.norm(other.velocity)) < 0.05:
+                continue
+            clear = me.half_width + other.half_width + LANE_MARGIN
+            d = np.linalg.norm(route - me.xy, axis=1)
+            i = int(np.argmin(d))
+            if d[i] >= clear:
+                continue
+            if d[i] > 1e-6:
+                away = (me.xy - route[i]) / d[i]
+            else:  # on the route itself: to its right
+                tangent = route[min(i + 1, len(route) - 1)] - route[max(i - 1, 0)]
+                away = np.array([tangent[1], -tangent[0]]) / max(float(np.linalg.norm(tangent)),
+                                                                 1e-9)
+            wanted = me.offset + away * (clear + 0.05 - d[i])
+            spot = ahead[:1] + np.array([*wanted, 0.0])
+            if self.cosim.fits(me.name, spot).all() and \
+                    float(np.linalg.norm(wanted)) > float(np.linalg.norm(best)):
+                best = wanted
+        return best
 
     # -- doorways ----------------------------------------------------------------------------
     def _doors_on(self, floor_z: float) -> FloatArray:
@@ -270,8 +308,9 @@ class LocalLayer:
         centre = self.doors[door, :2]
         if float(np.linalg.norm(me.xy - centre)) < DOOR_BUSY:
             return None
-        for other in others:
-            if other.z[1] < me.z[0] or other.z[0] > me.z[1] or other.kind == "lift":
+        for other in others:  # by their courses: a UAV climbing over a walker still counts
+            if other.kind == "lift" or other.base_z[1] < me.base_z[0] - 0.3 or \
+                    other.base_z[0] > me.base_z[1] + 0.3:
                 continue
             if float(np.linalg.norm(other.xy - centre)) < DOOR_BUSY:
                 return other  # someone is in the doorway

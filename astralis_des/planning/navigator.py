@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from astralis_des.errors import InputError
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
 if TYPE_CHECKING:
@@ -29,6 +30,8 @@ BODY_RADIUS = {"uav": 0.3, "ugv": 0.35, "human": 0.25}  # m, a disc around the b
 # up to a quarter metre (measured), and it should not brush a person's head
 KEEP_OUT = {"uav": 0.2, "ugv": 0.0, "human": 0.0}
 WINDOW = 3.0  # m around a leg that its planner may use
+RIM = 0.25  # m between the points a rectangular footprint is checked at, along its edges
+NUDGE = 0.6  # m: how far a leg's end in collision may be moved to a free point
 CELL = 0.1  # m, walkers' floor grid
 
 
@@ -206,6 +209,34 @@ class Navigator:
     # -- planning a leg --------------------------------------------------------------------
     def _plan_leg(self, robot: Robot, a: FloatArray, b: FloatArray,
                   radius: float) -> tuple[FloatArray | None, str]:
+        """A detour from ``a`` to ``b``. An end the planner finds in collision (a robot
+        stands closer to furniture than its margins allow, a goal beside a person) is moved
+        to the nearest free point within ``NUDGE`` first: the robot leaves from where it is,
+        and stops as near the goal as it can."""
+        fits = self.fits(robot, np.array([a, b]))
+        a2 = a if fits[0] else self._nudge(robot, a)
+        b2 = b if fits[1] else self._nudge(robot, b)
+        if a2 is None or b2 is None:
+            return None, "start in collision" if a2 is None else "goal in collision"
+        path, reason = self._plan_free_leg(robot, a2, b2, radius)
+        if path is None:
+            return None, reason
+        head = [a] if a2 is not a else []
+        return np.vstack([*head, path]), ""
+
+    def _nudge(self, robot: Robot, point: FloatArray) -> FloatArray | None:
+        """The nearest point within ``NUDGE`` (same height) where the robot fits."""
+        angles = np.arange(16) * (math.pi / 8)
+        for r in np.arange(0.1, NUDGE + 1e-9, 0.1):
+            ring = point + r * np.column_stack([np.cos(angles), np.sin(angles),
+                                                np.zeros(16)])
+            ok = self.fits(robot, ring)
+            if ok.any():
+                return np.asarray(ring[int(np.argmax(ok))])
+        return None
+
+    def _plan_free_leg(self, robot: Robot, a: FloatArray, b: FloatArray,
+                       radius: float) -> tuple[FloatArray | None, str]:
         self.plans += 1
         seed = (self.seed * 1_000_003 + next(self._counter)) % (2**31)
         lo = np.minimum(a, b) - WINDOW
@@ -229,7 +260,19 @@ class Navigator:
             heading = math.atan2(b[1] - a[1], b[0] - a[0])
             start = np.array([a[0], a[1], heading])
             goal = np.array([b[0], b[1], heading])
-            plan = plan_se2(lambda s: grid.free(s[:, :2], radius), lo[:2], hi[:2], start, goal,
+            footprint = KIND_DEFAULTS["ugv"].footprint
+            if footprint is not None:  # the body's rectangle at each state's heading
+                margin = self.cfg.margin
+
+                def valid(states: FloatArray) -> np.ndarray:
+                    points = rectangle_points(states, *footprint)
+                    ok = grid.free(points.reshape(-1, 2), margin + RIM / 2)
+                    return np.asarray(ok.reshape(len(states), -1).all(axis=1))
+            else:
+                def valid(states: FloatArray) -> np.ndarray:
+                    return np.asarray(grid.free(states[:, :2], radius))
+            start, goal = _facing(valid, start), _facing(valid, goal)
+            plan = plan_se2(valid, lo[:2], hi[:2], start, goal,
                             turning_radius=self.cfg.turning_radius, budget=budget,
                             space=self.cfg.ugv_space, seed=seed, resolution=0.05)
             if not plan.ok or plan.path is None:
@@ -265,3 +308,30 @@ class Navigator:
             occupied |= np.all((centers >= box[0, :2] - CELL / 2) &
                                (centers <= box[1, :2] + CELL / 2), axis=1)
         return GridMap.from_occupancy(occupied.reshape(tuple(shape)), lo, CELL)
+
+
+def rectangle_points(states: FloatArray, length: float, width: float) -> FloatArray:
+    """``(N, K, 2)``: points along the rim of a ``length`` x ``width`` body (and its centre)
+    at each ``(x, y, heading)`` state, ``RIM`` apart at most."""
+    along = np.linspace(-length / 2, length / 2, max(2, math.ceil(length / RIM) + 1))
+    across = np.linspace(-width / 2, width / 2, max(2, math.ceil(width / RIM) + 1))
+    rim = np.vstack([np.column_stack([along, np.full_like(along, -width / 2)]),
+                     np.column_stack([along, np.full_like(along, width / 2)]),
+                     np.column_stack([np.full_like(across, -length / 2), across]),
+                     np.column_stack([np.full_like(across, length / 2), across]),
+                     [[0.0, 0.0]]])
+    cos, sin = np.cos(states[:, 2]), np.sin(states[:, 2])
+    x = states[:, None, 0] + cos[:, None] * rim[None, :, 0] - sin[:, None] * rim[None, :, 1]
+    y = states[:, None, 1] + sin[:, None] * rim[None, :, 0] + cos[:, None] * rim[None, :, 1]
+    return np.stack([x, y], axis=2)
+
+
+def _facing(valid, state: FloatArray) -> FloatArray:  # type: ignore[no-untyped-def]
+    """``state`` (x, y, heading), turned to the nearest heading its footprint fits at, if
+    it does not fit at its own (a long body by a wall fits along it, not across)."""
+    turns = np.deg2rad(np.array([0, 15, -15, 30, -30, 45, -45, 60, -60, 75, -75, 90, -90,
+                                 105, -105, 120, -120, 135, -135, 150, -150, 165, -165, 180]))
+    candidates = np.repeat(state[None, :], len(turns), axis=0)
+    candidates[:, 2] = state[2] + turns
+    ok = valid(candidates)
+    return np.asarray(candidates[int(np.argmax(ok))]) if ok.any() else state

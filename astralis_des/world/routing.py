@@ -101,17 +101,24 @@ class Router:
                 yc = self._pos[corridor[0]][1]
                 node = self._node(f"{b.id}.{floor}.stair", (sx, yc, z))
                 self._edge(node, corridor[0])
+                # the flights of stairs go south of the landing where there is room for them,
+                # else north; UAVs change floors at the north end, clear of the lift and (off
+                # the flights' line) of the walkers
+                run = STAIR_RUN_FACTOR * b.floor_height / 2
+                south = yc - run >= stair.lo[1] + 0.5
                 if previous is not None:  # a UGV takes the lift where there is one
-                    self._stairs(previous, node, stair.lo[1] + 0.5, tuple(
+                    self._stairs(previous, node, (yc - run) if south else
+                                 min(yc + run, stair.hi[1] - 0.5), tuple(
                         k for k in passable if k != "uav" and (k != "ugv" or b.lift is None)))
                 if "ugv" in passable and b.lift is not None:  # onto the lift's platform
                     lift = self._node(f"{b.id}.{floor}.lift", (*b.lift.center[:2], z))
                     self._edge(node, lift, ("ugv",))
                     if floor > 1:
                         self._edge(self.index[f"{b.id}.{floor - 1}.lift"], lift, ("ugv",))
-                if "uav" in passable:  # UAVs rise and sink at the far end, clear of the lift
+                if "uav" in passable:
+                    wx = sx if south or b.lift is None else b.lift.center[0]
                     well = self._node(f"{b.id}.{floor}.well",
-                                      (sx, max(stair.hi[1] - UAV_WELL, yc), z))
+                                      (wx, max(stair.hi[1] - UAV_WELL, yc), z))
                     self._edge(node, well, ("uav",))
                     if floor > 1:
                         self._edge(self.index[f"{b.id}.{floor - 1}.well"], well, ("uav",))
@@ -140,18 +147,16 @@ class Router:
             for b_idx in others[clear]:
                 self._edge(self.outdoor_nodes[a], self.outdoor_nodes[b_idx])
 
-    def _stairs(self, lower: int, upper: int, y_min: float, walkers: tuple[str, ...]) -> None:
+    def _stairs(self, lower: int, upper: int, y_mid: float, walkers: tuple[str, ...]) -> None:
         """Between two floors of a stairwell, from its landing (the stair node, by the
-        corridor): ``walkers`` take a switchback flight south of the landing, whose
-        mid-landing makes the route as long as the stairs (run = 2 x rise). (The UGV rides
-        the lift in its shaft west of the landing, UAVs rise in the open well at the north
-        end: ``_build``.)"""
-        x, y, z0 = self._pos[lower]
+        corridor): ``walkers`` take a switchback flight to a mid-landing at ``y_mid`` (a run
+        of twice the rise makes the route as long as the stairs). (The UGV rides the lift in
+        its shaft west of the landing, UAVs rise in the open well at the north end:
+        ``_build``.)"""
+        x, _, z0 = self._pos[lower]
         rise = self._pos[upper][2] - z0
         if walkers:
-            run = STAIR_RUN_FACTOR * rise / 2
-            mid = self._node(f"{self.names[lower]}:flight",
-                             (x, max(y - run, y_min), z0 + rise / 2))
+            mid = self._node(f"{self.names[lower]}:flight", (x, y_mid, z0 + rise / 2))
             self._edge(lower, mid, walkers)
             self._edge(mid, upper, walkers)
 
