@@ -4,7 +4,6 @@ change floors at the stairwell's far end, clear of it."""
 from __future__ import annotations
 
 import itertools
-
 from pathlib import Path
 
 import numpy as np

@@ -14,8 +14,8 @@ an avatar in the next room is no reason to move. The rules, as people keep to in
   body is in it, or while a robot of higher priority is about to cross it; a robot waiting
   for another that comes its way steps off that one's route, where there is room;
 - step aside: something standing still in the lane is passed on the side with room;
-- a UAV on a walker's (a person's, an avatar's) collision course climbs and waits above it
-  until it has passed below;
+- a UAV on a walker's (a person's, an avatar's) collision course climbs over it (holding
+  while it climbs, if the walker moves) and comes back down once it is past;
 - a robot standing idle in another's way (in its lane, in the doorway it waits for, on its
   goal) is asked to make way: it moves to the nearest free spot off the other's path
   (:meth:`PhysicsCoSim.make_way`); a goal a body stands on counts as reached from farther.
@@ -335,8 +335,8 @@ class LocalLayer:
 
     def _climb(self, me: Body, others: list[Body], velocity: FloatArray) -> tuple[float, bool]:
         """How far a UAV going at ``velocity`` climbs (where it is) to pass over a walker
-        on a collision course with it, and whether it waits up there: for a walker that
-        moves, until it has passed below; over one standing still it flies on."""
+        on a collision course with it, and whether it waits while it climbs (for a walker
+        that moves; once up there, it flies on over it)."""
         need, wait = 0.0, False
         for other in others:
             if other.kind not in WALKERS or other.z[1] < me.base_z[0]:
@@ -348,6 +348,7 @@ class LocalLayer:
         need = min(need, MAX_CLIMB)
         if need <= 0.0:
             return 0.0, False
+        wait = wait and me.z[0] - me.base_z[0] < need - 0.05  # up there, it flies on
         centre = (me.base_z[0] + me.base_z[1]) / 2
         above = np.array([[*me.xy, centre + need]])
         return (need, wait) if self.cosim.fits(me.name, above).all() else (0.0, False)
