@@ -22,6 +22,14 @@ def corridor_mission(team: list[dict]) -> Simulation:
         assignment={**base.spec.assignment.model_dump(), "start_at": 3600.0}))
 
 
+def add_walker(sim: Simulation, ends: list[tuple[float, float]], offset: float = 0.0) -> None:
+    """An avatar pacing between two points of the ground floor at 0.6 m/s."""
+    loop = np.array([[*ends[0], 0.86], [*ends[1], 0.86], [*ends[0], 0.86]])
+    walker = Mover("avatar:walker", "avatar", loop, 0.6, (0.5, 0.5, 1.72), offset=offset)
+    sim.scene.movers.append(walker)
+    sim.cosim._add_movers([walker])
+
+
 def contacts_between(sim: Simulation, a: str, b: str) -> list[dict]:
     return [e for e in sim.log.records if e["kind"] == "contact"
             and {e.get("robot"), e.get("other")} == {a, b}]
@@ -48,11 +56,7 @@ def test_a_walker_crossing_the_ugvs_path_is_let_through() -> None:
     """An avatar walks across the corridor, from a room to the one opposite and back, as the
     UGV drives along it: the UGV waits for it to pass, and nothing touches."""
     sim = corridor_mission([{"id": "ugv1", "kind": "ugv", "start": [65.0, CORRIDOR_Y, 0.0]}])
-    crossing = Mover("avatar:crossing", "avatar",
-                     np.array([[72.0, 74.5, 0.86], [72.0, 82.0, 0.86], [72.0, 74.5, 0.86]]),
-                     0.6, (0.5, 0.5, 1.72), offset=14.55)  # mid-corridor at t = 7 s
-    sim.scene.movers.append(crossing)
-    sim.cosim._add_movers([crossing])
+    add_walker(sim, [(72.0, 74.5), (72.0, 82.0)], offset=14.55)  # mid-corridor at t = 7 s
     sim.start()
     drive = sim.enqueue("ugv1", "move", params={"x": 79.0, "y": CORRIDOR_Y})
     sim.advance(60.0)
@@ -66,11 +70,7 @@ def _flight_past_avatar(uav_y: float, avatar_y: float) -> Simulation:
     """A UAV flies east along the corridor at ``uav_y`` while an avatar walks west at
     ``avatar_y``, 1.05 m to its left, over the same stretch (x 68.4 to 71.6)."""
     sim = corridor_mission([{"id": "uav1", "kind": "uav", "start": [64.5, uav_y, 0.0]}])
-    walker = Mover("avatar:walker", "avatar",
-                   np.array([[71.6, avatar_y, 0.86], [68.4, avatar_y, 0.86],
-                             [71.6, avatar_y, 0.86]]), 0.6, (0.5, 0.5, 1.72))
-    sim.scene.movers.append(walker)
-    sim.cosim._add_movers([walker])
+    add_walker(sim, [(71.6, avatar_y), (68.4, avatar_y)])
     sim.start()
     done = sim.enqueue("uav1", "move", params={"x": 76.0, "y": uav_y})
     sim.advance(30.0)

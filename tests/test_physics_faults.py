@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from astralis_des import Simulation, load_mission
-from astralis_des.kernel.robot import Motion
+from astralis_des.kernel.robot import Motion, Robot
 
 MISSIONS = Path(__file__).resolve().parents[1] / "missions"
 
@@ -17,6 +18,20 @@ MISSIONS = Path(__file__).resolve().parents[1] / "missions"
 def fig7_physics(**changes: object) -> Simulation:
     return Simulation(load_mission(MISSIONS / "fig7.yaml").with_changes(fidelity="physics",
                                                                         **changes))
+
+
+def run_motion(sim: Simulation, robot: Robot, motion: Motion, until: float) -> list[Any]:
+    """Send one motion to the co-simulation directly: ``[outcome, end time]`` (empty if it
+    has not ended by ``until``)."""
+    outcome: list[Any] = []
+
+    def go():  # type: ignore[no-untyped-def]
+        outcome.append((yield sim.cosim.execute(robot, motion)))
+        outcome.append(sim.env.now)
+
+    sim.env.process(go())
+    sim.env.run(until=until)
+    return outcome
 
 
 def test_a_uav_tipped_over_mid_search_is_faulted_and_its_room_searched_by_another() -> None:
@@ -94,17 +109,10 @@ def test_a_robot_pushed_back_and_forth_is_failed_as_stuck_within_its_cap() -> No
         return tick(t)
 
     driver.tick = pushed
-    outcome: list[object] = []
-
-    def go():  # type: ignore[no-untyped-def]
-        outcome.append((yield sim.cosim.execute(robot, motion)))
-        outcome.append(sim.env.now)
-
-    sim.env.process(go())
-    sim.env.run(until=60.0)
+    outcome = run_motion(sim, robot, motion, 60.0)
     assert outcome, "the motion never ended"
     result, ended = outcome
-    assert result.reason == "stuck: no progress for 4 s"  # type: ignore[attr-defined]
+    assert result.reason == "stuck: no progress for 4 s"
     times, points = np.array(robot.trail_t), np.array(robot.trail_p)
     late = points[times > 5.0][:, 0]
     assert np.abs(np.diff(late)).sum() > 0.5  # it was moving about all along
@@ -119,16 +127,8 @@ def test_a_motion_that_takes_far_longer_than_planned_times_out() -> None:
     sim = fig7_physics(physics={"stuck_timeout": 500.0})
     robot = sim.robots["uav1"]
     motion = Motion(np.array([robot.pose, (78.0, 80.0, 1.5)]), robot.speed, accel=robot.accel)
-    outcome: list[object] = []
-
-    def go():  # type: ignore[no-untyped-def]
-        outcome.append((yield sim.cosim.execute(robot, motion)))
-        outcome.append(sim.env.now)
-
-    sim.env.process(go())
-    sim.env.run(until=200.0)
-    result, ended = outcome
+    result, ended = run_motion(sim, robot, motion, 200.0)
     cap = 2 * motion.duration + 30.0
-    assert result.reason == f"timed out: not there after {cap:.0f} s"  # type: ignore[attr-defined]
+    assert result.reason == f"timed out: not there after {cap:.0f} s"
     assert cap <= ended < cap + 0.5
     sim.finish()

@@ -14,7 +14,6 @@ import math
 import shutil
 import tempfile
 from collections.abc import Callable, Generator
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -30,8 +29,10 @@ from astralis_des.physics.drivers import DRIVERS, Driver, HumanDriver
 from astralis_des.physics.hexacopter import write_urdf
 from astralis_des.physics.lift import Lift, lifts_of
 from astralis_des.physics.local import RATE as LOCAL_RATE
-from astralis_des.physics.local import LocalLayer, aside
+from astralis_des.physics.local import LocalLayer
+from astralis_des.physics.make_way import aside
 from astralis_des.physics.perception import Perception
+from astralis_des.physics.track import Track
 from astralis_des.physics.ugv_driver import UgvDriver
 from astralis_des.sensing import GeometricSensor, Sighting
 from astralis_des.world.clutter import Clutter
@@ -47,38 +48,6 @@ FLOORS = ("wall", "ground", "lift")  # what holds a ground robot up (slabs are s
 CAP_FACTOR, CAP_SLACK = 2.0, 30.0  # a motion planned to take T s fails after 2 T + 30 s
 TURN_CAP = 30.0  # s: a turn on the spot that takes longer has failed
 RISE_AHEAD = 1.0  # s: a waiting UAV that a walking avatar reaches this soon has risen over it
-
-
-@dataclass
-class Track:
-    """The motion of a robot in physics: its pose is read from the body; the trail and the
-    distance are sampled as it goes."""
-
-    driver: Driver
-    t0: float
-    cap: float  # s: the motion fails if it takes longer
-    times: list[float] = field(default_factory=list)
-    points: list[FloatArray] = field(default_factory=list)
-    odometry: float = 0.0
-    best: tuple[float, float] = (0.0, 0.0)  # the most progress made (m), and when
-
-    def sample(self, t: float) -> FloatArray:
-        here = self.driver.position()
-        if self.points:
-            self.odometry += float(np.linalg.norm(here - self.points[-1]))
-        self.times.append(t)
-        self.points.append(here)
-        return here
-
-    def at(self, t: float) -> FloatArray:
-        return self.driver.position()
-
-    def travelled(self, t: float) -> float:
-        return self.odometry + float(np.linalg.norm(self.driver.position() - self.points[-1]))
-
-    def vertices_until(self, t: float) -> tuple[FloatArray, FloatArray]:
-        return (np.append(self.times, t),
-                np.vstack([*self.points, self.driver.position()[None, :]]))
 
 
 @COSIMS.register("physics")

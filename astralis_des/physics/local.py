@@ -18,7 +18,7 @@ an avatar in the next room is no reason to move. The rules, as people keep to in
   while it climbs, if the walker moves) and comes back down once it is past;
 - a robot standing idle in another's way (in its lane, in the doorway it waits for, on its
   goal) is asked to make way: it moves to the nearest free spot off the other's path
-  (:meth:`PhysicsCoSim.make_way`); a goal a body stands on counts as reached from farther.
+  (:mod:`.make_way`); a goal a body stands on counts as reached from farther.
 """
 
 from __future__ import annotations
@@ -34,7 +34,6 @@ from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
 if TYPE_CHECKING:
     from astralis_des.cosim.physics import PhysicsCoSim
-    from astralis_des.kernel.robot import Robot
     from astralis_des.physics.drivers import Driver
 
 PASS_RANGE = 5.0  # m: closer than this, head-on, both keep right
@@ -360,38 +359,6 @@ def _closest_approach(rel: FloatArray, velocity: FloatArray, horizon: float) -> 
     speed2 = float(velocity @ velocity)
     t = 0.0 if speed2 < 1e-9 else min(max(-float(rel @ velocity) / speed2, 0.0), horizon)
     return float(np.linalg.norm(rel + velocity * t))
-
-
-ASIDE_STEPS = (1.0, 1.5, 2.0)  # m: how far a robot making way may go
-ASIDE_DIRECTIONS = 16
-
-
-def aside(cosim: PhysicsCoSim, robot: Robot, here: FloatArray, path: FloatArray,
-          asker_kind: str) -> FloatArray | None:
-    """The nearest spot (at ``here``'s height, on the same floor) where ``robot`` is clear of
-    ``path`` by both bodies' radii and a margin, fits among walls and furniture, is not in a
-    doorway, and is reached in a straight line: where it goes to make way, or None."""
-    angles = np.arange(ASIDE_DIRECTIONS) * (2 * math.pi / ASIDE_DIRECTIONS)
-    rings = [here + np.column_stack([np.cos(angles), np.sin(angles), np.zeros(len(angles))]) * r
-             for r in ASIDE_STEPS]
-    spots = np.vstack(rings)
-    clear_of = RADII[robot.kind] + RADII[asker_kind] + 0.3
-    gaps = np.linalg.norm(spots[:, None, :2] - path[None, :, :2], axis=2).min(axis=1)
-    doors = cosim.world.doorways
-    floor = cosim.world.floor_below(here - np.array([0.0, 0.0, robot.height]))
-    near_door = np.zeros(len(spots), dtype=bool)
-    if len(doors):
-        mine = doors[np.abs(doors[:, 2] - floor) < 1.0]
-        if len(mine):
-            near_door = np.linalg.norm(spots[:, None, :2] - mine[None, :, :2],
-                                       axis=2).min(axis=1) < DOOR_BUSY
-    for index in np.flatnonzero((gaps >= clear_of) & ~near_door):
-        spot = spots[index]
-        leg = here + (spot - here) * np.linspace(0.0, 1.0, 6)[:, None]
-        if cosim.fits(robot.id, leg).all() and not segments_hit_boxes(
-                here[None, :], spot[None, :], cosim.world.solid_array)[0]:
-            return spot
-    return None
 
 
 def _on_route(route: FloatArray, xy: FloatArray, velocity: FloatArray) -> tuple[float, float]:

@@ -1,0 +1,47 @@
+"""Making way: where a robot standing idle in another's way goes (the local layer asks, the
+co-simulation moves it there)."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from astralis_des.physics.local import DOOR_BUSY, RADII
+from astralis_des.world.geometry import FloatArray, segments_hit_boxes
+
+if TYPE_CHECKING:
+    from astralis_des.cosim.physics import PhysicsCoSim
+    from astralis_des.kernel.robot import Robot
+
+ASIDE_STEPS = (1.0, 1.5, 2.0)  # m: how far a robot making way may go
+ASIDE_DIRECTIONS = 16
+
+
+def aside(cosim: PhysicsCoSim, robot: Robot, here: FloatArray, path: FloatArray,
+          asker_kind: str) -> FloatArray | None:
+    """The nearest spot (at ``here``'s height, on the same floor) where ``robot`` is clear of
+    ``path`` by both bodies' radii and a margin, fits among walls and furniture, is not in a
+    doorway, and is reached in a straight line: where it goes to make way, or None."""
+    angles = np.arange(ASIDE_DIRECTIONS) * (2 * math.pi / ASIDE_DIRECTIONS)
+    rings = [here + np.column_stack([np.cos(angles), np.sin(angles), np.zeros(len(angles))]) * r
+             for r in ASIDE_STEPS]
+    spots = np.vstack(rings)
+    clear_of = RADII[robot.kind] + RADII[asker_kind] + 0.3
+    gaps = np.linalg.norm(spots[:, None, :2] - path[None, :, :2], axis=2).min(axis=1)
+    doors = cosim.world.doorways
+    floor = cosim.world.floor_below(here - np.array([0.0, 0.0, robot.height]))
+    near_door = np.zeros(len(spots), dtype=bool)
+    if len(doors):
+        mine = doors[np.abs(doors[:, 2] - floor) < 1.0]
+        if len(mine):
+            near_door = np.linalg.norm(spots[:, None, :2] - mine[None, :, :2],
+                                       axis=2).min(axis=1) < DOOR_BUSY
+    for index in np.flatnonzero((gaps >= clear_of) & ~near_door):
+        spot = spots[index]
+        leg = here + (spot - here) * np.linspace(0.0, 1.0, 6)[:, None]
+        if cosim.fits(robot.id, leg).all() and not segments_hit_boxes(
+                here[None, :], spot[None, :], cosim.world.solid_array)[0]:
+            return spot
+    return None
