@@ -157,9 +157,10 @@ def test_an_inspect_point_under_a_table_is_skipped_not_failed() -> None:
     """The operator's inspection loop has a corner under a table (the walker's planner, on
     its floor grid, cannot stand there): the search succeeds without that corner, says so,
     and walks the other corners; it does not fail the whole room."""
+    from conftest import MISSIONS
+
     from astralis_des import Simulation, load_mission
     from astralis_des.world.clutter import Clutter, Placed
-    from tests.conftest import MISSIONS
 
     base = load_mission(MISSIONS / "fig7.yaml")
     sim = Simulation(base.with_changes(

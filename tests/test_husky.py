@@ -47,9 +47,10 @@ def test_a_sneak_peek_at_every_door_of_building_a_touches_no_wall() -> None:
     """One UGV looks into all 18 rooms of building A in turn, riding the lift between
     floors: every sneak peek succeeds, the robot stops where it can turn on the spot (its
     half-diagonal and a margin from the wall), and its body never touches a wall."""
+    from conftest import MISSIONS
+
     from astralis_des import Simulation, load_mission
     from astralis_des.actions.common import stand_off
-    from tests.conftest import MISSIONS
 
     base = load_mission(MISSIONS / "fig7.yaml")
     sim = Simulation(base.with_changes(

@@ -136,13 +136,13 @@ class LocalLayer:
         self.near = [int(i) for i in np.flatnonzero((gaps < NEAR).any(axis=1))]
         by_name = {b.name: b for b in bodies}
         paths = {rid: self.cosim.drivers[rid].path_ahead(PATH_AHEAD) for rid in self.cosim.active}
-        doors = {rid: self._door_ahead(by_name[rid], path) for rid, path in paths.items()}
+        doors = _Doors(self, by_name, paths)
         self._paths = {rid: path[:, :2] + by_name[rid].offset for rid, path in paths.items()}
         for rid in self.cosim.active:
             self._decide_for(rid, by_name[rid], bodies, where, paths[rid], doors)
 
     def _decide_for(self, rid: str, me: Body, bodies: list[Body], where: FloatArray,
-                    ahead: FloatArray, doors: dict[str, int | None]) -> None:
+                    ahead: FloatArray, doors: _Doors) -> None:
         driver = self.cosim.drivers[rid]
         self._deciding = rid
         direction = driver.heading_vector()
@@ -153,8 +153,15 @@ class LocalLayer:
         forward = direction / speed
         right = np.array([forward[1], -forward[0]])
         near = np.linalg.norm(where - me.xy, axis=1) < PASS_RANGE + 1.0
+        low, high = me.base_z[0] - 0.3, max(me.z[1], me.base_z[1]) + 0.3
         others = self._in_sight(me, [b for b, c in zip(bodies, near, strict=True)
-                                     if c and b.name != me.name])
+                                     if c and b.name != me.name
+                                     and max(b.z[1], b.base_z[1]) >= low
+                                     and min(b.z[0], b.base_z[0]) <= high])
+        if not others:  # nothing in sight: nothing to avoid (the usual case, and cheap)
+            driver.arrive_within = 0.2
+            driver.avoid(False, np.zeros(2))
+            return
         route = ahead[:, :2] + me.offset
         if len(route) < 3:  # at the end of its path: the way it is headed
             route = me.xy + forward * np.arange(0.0, PATH_AHEAD, SAMPLE)[:, None]
@@ -301,7 +308,7 @@ class LocalLayer:
         return int(hit[0, 1]) if len(hit) else None
 
     def _door_taken(self, rid: str, me: Body, door: int, others: list[Body],
-                    doors: dict[str, int | None]) -> Body | None:
+                    doors: _Doors) -> Body | None:
         """Whom must this robot wait for at the doorway on its path? No one once it is in
         it."""
         centre = self.doors[door, :2]
@@ -313,7 +320,8 @@ class LocalLayer:
                 continue
             if float(np.linalg.norm(other.xy - centre)) < DOOR_BUSY:
                 return other  # someone is in the doorway
-            if doors.get(other.name) == door and other.rank > me.rank and \
+            if other.name in self.cosim.active and doors.get(other.name) == door and \
+                    other.rank > me.rank and \
                     other.rank != STILL_RANK:
                 return other  # a robot of higher priority is about to go through
         return None
@@ -390,3 +398,21 @@ def _round(path: FloatArray, xy: FloatArray, clear: float) -> FloatArray | None:
     offset = float((xy - path[i]) @ normal)  # where it stands, across the path
     side = offset - clear if offset >= 0 else offset + clear
     return normal * side
+
+
+class _Doors:
+    """The doorway on each moving robot's path ahead, found when first asked for."""
+
+    def __init__(self, layer: LocalLayer, bodies: dict[str, Body],
+                 paths: dict[str, FloatArray]) -> None:
+        self.layer, self.bodies, self.paths = layer, bodies, paths
+        self.found: dict[str, int | None] = {}
+
+    def get(self, rid: str) -> int | None:
+        if rid not in self.found:
+            path = self.paths.get(rid)
+            self.found[rid] = None if path is None else self.layer._door_ahead(
+                self.bodies[rid], path)
+        return self.found[rid]
+
+    __getitem__ = get

@@ -23,6 +23,7 @@ from astralis_des.world.geometry import FloatArray
 
 GOVERN = 0.5  # m: farther than this from its reference point, the reference waits
 CRASH_TILT = 60.0  # degrees: a multirotor tilted this far has lost its lift: crashed
+COS_CRASH_TILT = math.cos(math.radians(CRASH_TILT))
 FALL = 1.0  # m below its course (its controller holds it within centimetres): crashed
 CLIMB_RATE = 1.2  # m/s: how fast it climbs over a walker, and comes back down
 
@@ -41,6 +42,7 @@ class UavDriver(Avoiding):
         self.motion: Motion | None = None
         self.ref: FloatArray = np.asarray(robot.pose, dtype=float)[None, :]
         self.ref_s: FloatArray = np.zeros(1)
+        self._last = 0
         self.k = 0
         self._clear_avoidance()
         self.freeze()
@@ -59,6 +61,7 @@ class UavDriver(Avoiding):
         self.ref_pos, self.ref_vel = pos.tolist(), vel.tolist()
         self.ref_acc = _acceleration(vel, self.period, motion.accel).tolist()
         self.goal = pos[-1]
+        self._last = len(pos) - 1
         self.k = 0  # the reference's clock, in ticks: it stops while the robot holds
         self.lag = 0.0
         self._clear_avoidance()
@@ -93,16 +96,16 @@ class UavDriver(Avoiding):
         return np.asarray(self.ref[-1])
 
     def tick(self, t: float) -> str | None:
-        last = self.last
-        k = min(self.k, last)
+        last = self._last
+        k = self.k if self.k < last else last
         if k >= last:
             pos, _, v, _ = self.craft.state()
             if math.dist(pos, self.goal) < self.arrive_within and math.hypot(*v) < 0.3:
                 return "arrived"
         self.shift = ramp(self.shift, self.shift_to, self.shift_rate * self.period)
         self.lift_z = _toward(self.lift_z, self.lift_to, CLIMB_RATE * self.period)
-        ref = self.ref_pos[k]
-        target = (ref[0] + self.shift[0], ref[1] + self.shift[1], ref[2] + self.lift_z)
+        ref, (sx, sy) = self.ref_pos[k], self.shift.tolist()
+        target = (ref[0] + sx, ref[1] + sy, ref[2] + self.lift_z)
         if self.held or self.lag > GOVERN:  # hold, or wait for the craft: fly to the point
             self.lag = self.craft.control(target, (0.0, 0.0, 0.0))
         else:
@@ -119,11 +122,10 @@ class UavDriver(Avoiding):
 
     def crashed(self) -> str | None:
         """Why the craft is down (tipped over, or fallen below its course), if it is."""
-        tilt = self.craft.tilt_deg()
-        if tilt > CRASH_TILT:
-            return f"crashed: tipped over ({tilt:.0f} degrees)"
-        course = float(self.ref[min(self.k, self.last), 2])
-        drop = course - float(self.craft.position()[2])
+        (_, _, z), (qx, qy, _, _) = self.client.call("getBasePositionAndOrientation", self.body)
+        if 1.0 - 2.0 * (qx * qx + qy * qy) < COS_CRASH_TILT:
+            return f"crashed: tipped over ({self.craft.tilt_deg():.0f} degrees)"
+        drop = float(self.ref[min(self.k, self.last), 2]) - z
         if drop > FALL:
             return f"crashed: fell {drop:.1f} m below its course"
         return None

@@ -164,13 +164,16 @@ class UgvDriver(Avoiding):
         return next((lift for lift in self.lifts if lift.contains(point)), None)
 
     # -- the control period ----------------------------------------------------------------
-    def tick(self, t: float) -> str | None:
+    def _count_turning(self) -> None:
+        """Add the turn on the spot since the last look to the progress made."""
         yaw = self.husky.pose()[3]
-        if self.turning or abs(yaw - self._yaw) > 1e-4:
-            self.turned += abs(math.remainder(yaw - self._yaw, math.tau)) * (
-                self.turning or self.husky.spinning)
-            self._yaw = yaw
+        if self.turning or self.husky.spinning:
+            self.turned += abs(math.remainder(yaw - self._yaw, math.tau))
+        self._yaw = yaw
+
+    def tick(self, t: float) -> str | None:
         if self.turning:
+            self._count_turning()
             return self._turn()
         self._free_lift()
         if self.ride is not None:
@@ -185,6 +188,7 @@ class UgvDriver(Avoiding):
         self._ticks += 1
         if self._ticks % self.every:  # the wheel motors hold their targets
             return None
+        self._count_turning()
         self._check_blocked(t)
         self.shift = ramp(self.shift, self.shift_to, self.shift_rate * self.period * self.every)
         self.husky.offset = self.shift
