@@ -335,7 +335,27 @@ def _print_summary(console: Any, result: RunResult, out: Path) -> None:
                       f"{s.idle_time:.1f}", str(s.tasks_succeeded), str(s.tasks_failed),
                       str(s.tasks_cancelled), str(s.tasks_preempted))
     console.print(table)
+    if not result.found:
+        _print_rooms(console, result)
     console.print(f"outputs: {out}/")
+
+
+def _print_rooms(console: Any, result: RunResult) -> None:
+    """Per room, what was seen of it and by whom: "hidden by furniture" is not "never looked"."""
+    from rich.table import Table
+
+    table = Table(title="rooms")
+    for header in ("room", "status", "seen", "searches"):
+        table.add_column(header, justify="right" if header == "seen" else "left")
+    for room, entry in result.rooms.items():
+        seen = "-" if entry["coverage"] is None else f"{entry['coverage']:.0%}"
+        searches = ", ".join(
+            f"{s['robot']} {s['action']} {s['status']}"
+            + ("" if s["coverage"] is None else f" {s['coverage']:.0%}")
+            for s in entry["searches"])
+        mark = " (target)" if room == result.target["room"] else ""
+        table.add_row(room + mark, entry["status"].replace("_", " "), seen, searches or "-")
+    console.print(table)
 
 
 if __name__ == "__main__":

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 class CameraDefaults:
     """A kind's camera when the mission does not say: its reach and where it looks."""
 
-    range: float  # m: farther than this the target is not detected
+    range: float | None  # m: a cap on the detector's reach; None: the pixels decide
     fov_deg: float  # vertical field of view
     pitch_deg: float  # 0 forward, 90 straight down
     gimbal: bool  # levelled and turned to the direction of travel (else fixed to the body)
@@ -39,15 +39,17 @@ class KindDefaults:
 KIND_DEFAULTS: dict[str, KindDefaults] = {
     # A gimballed camera 75 degrees down: at 1.5 m over the floor it sees a strip about
     # 3 m wide below the craft, mostly ahead of it.
-    "uav": KindDefaults(speed=1.5, camera=CameraDefaults(2.0, 90.0, 75.0, True, True),
+    "uav": KindDefaults(speed=1.5, camera=CameraDefaults(None, 90.0, 75.0, True, True),
                         height=1.5, distance="l2", sensors=("camera", "imu"), accel=2.0),
     # A forward camera on the body, and a lidar the local planner slows down for.
-    "ugv": KindDefaults(speed=1.0, camera=CameraDefaults(6.0, 60.0, 0.0, False, False),
+    "ugv": KindDefaults(speed=1.0, camera=CameraDefaults(None, 60.0, 0.0, False, False),
                         height=0.5, distance="manhattan", sensors=("camera", "lidar", "imu"),
                         accel=1.0, turn_rate=1.0, footprint=(1.01, 0.69)),  # the Husky
     # A person's eyes: a wide view a little down, ahead of where they walk.
-    "human": KindDefaults(speed=1.2, camera=CameraDefaults(3.0, 90.0, 15.0, True, True),
+    "human": KindDefaults(speed=1.2, camera=CameraDefaults(None, 90.0, 15.0, True, True),
                           height=1.6, distance="manhattan", sensors=("camera",)),
 }
 KINDS = tuple(KIND_DEFAULTS)
 TARGET_HEIGHT = 0.5  # m above the floor: the centre of a sitting or laying avatar
+TARGET_SIZE = (0.5, 0.5, 2 * TARGET_HEIGHT)  # m: the box of a sitting avatar
+TARGET_FACE = TARGET_SIZE[1] * TARGET_SIZE[2]  # m^2: its side, seen square on

@@ -1,11 +1,13 @@
-"""The kinematic fidelity's sensing model: a camera frustum plus a line of sight.
+"""The kinematic fidelity's sensing model: the shared detection model on the camera's view.
 
-A robot's camera (:class:`View`) sees a point when it lies within the camera's range and
-inside its pinhole frustum, and no wall, slab, obstacle, furniture or avatar is in between.
-A gimballed camera (UAV, person) turns to the direction of travel; a body camera (UGV) turns
-with the body. Physics fidelity replaces the model with rendered frames; both answer the same
-questions: when, along a motion, is the target first seen, where was it estimated to be, and
-what share of a room's floor did the robot see.
+A robot's camera (:class:`View`) detects the target when it would show at least
+``min_pixels`` of it (:mod:`astralis_des.detection`: the target's box projected under the
+camera's intrinsics, less what walls, slabs, obstacles, furniture and avatars hide), within
+its range when one is set. A gimballed camera (UAV, person) turns to the direction of
+travel; a body camera (UGV) turns with the body. Physics fidelity counts the same pixels in
+rendered frames; both answer the same questions: when, along a motion, is the target first
+seen, where was it estimated to be, and what share of a room's floor did the robot see (the
+floor cells where a target would show ``min_pixels`` with its centre in sight).
 """
 
 from __future__ import annotations
@@ -15,9 +17,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from astralis_des.detection import predict_pixels
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kinds import TARGET_HEIGHT
-from astralis_des.view import look_headings, travel_headings
+from astralis_des.view import View, look_headings, travel_headings
 from astralis_des.world.geometry import FloatArray, resample
 from astralis_des.world.model import Room
 
@@ -26,6 +29,8 @@ if TYPE_CHECKING:
 
 SAMPLE_STEP = 0.25  # m between sensing samples along a path
 CELL = 0.5  # m, floor cells for coverage
+CHUNK = 16  # looks judged at a time, in time order, until one detects
+CORNERS = np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5])).reshape(3, -1).T
 
 
 @dataclass(frozen=True)
@@ -68,19 +73,35 @@ class GeometricSensor:
 
     def _first(self, robot: Robot, pts: FloatArray, headings: FloatArray, times: FloatArray,
                targets: FloatArray) -> Sighting | None:
-        assert robot.view is not None
-        near = np.flatnonzero(robot.view.sees(pts, headings, targets))
+        view = robot.view
+        assert view is not None
+        size = np.asarray(self.target.size, dtype=float)
+        # cheap tests first: can any corner of the box be in the frame, and would the box
+        # show enough pixels if nothing hid it?
+        every = np.arange(len(pts))
+        near, _ = _in_frame(view, pts, headings, targets, size, every, every)
         if len(near) == 0:
             return None
-        clear = self.scene.line_of_sight(pts[near], targets[near])
-        if not clear.any():
-            return None
-        i = int(near[np.argmax(clear)])
-        distance = float(np.linalg.norm(pts[i] - targets[i]))
-        noise = self.rng.normal(0.0, robot.view.position_noise * distance, 3)
-        estimate = targets[i] + noise
-        return Sighting(float(times[i]), _xyz(pts[i]), _xyz(targets[i]), distance,
-                        _xyz(estimate), float(np.linalg.norm(noise)))
+        bound = predict_pixels(view, pts[near], headings[near], targets[near], size, None)
+        near = near[bound >= view.min_pixels]
+        for start in range(0, len(near), CHUNK):
+            idx = near[start:start + CHUNK]
+            pixels = predict_pixels(view, pts[idx], headings[idx], targets[idx], size,
+                                    self.scene.line_of_sight)
+            hits = np.flatnonzero(pixels >= view.min_pixels)
+            if len(hits):
+                i, count = int(idx[hits[0]]), int(pixels[hits[0]])
+                return self._sighting(view.position_noise, pts[i], targets[i], float(times[i]),
+                                      count)
+        return None
+
+    def _sighting(self, noise_share: float, eye: FloatArray, target: FloatArray, t: float,
+                  pixels: int) -> Sighting:
+        distance = float(np.linalg.norm(eye - target))
+        noise = self.rng.normal(0.0, noise_share * distance, 3)
+        estimate = target + noise
+        return Sighting(t, _xyz(eye), _xyz(target), distance, _xyz(estimate),
+                        float(np.linalg.norm(noise)), pixels)
 
     def coverage(self, robot: Robot, points: FloatArray, room: Room,
                  headings: FloatArray | None = None) -> float:
@@ -96,11 +117,14 @@ class GeometricSensor:
             cells = cells[~under]
             if len(cells) == 0:
                 return 0.0
+        view = robot.view
         pts, heads = _sample_path(robot, np.asarray(points, dtype=float), headings)
         pi = np.repeat(np.arange(len(pts)), len(cells))
         ci = np.tile(np.arange(len(cells)), len(pts))
-        inside = robot.view.sees(pts[pi], heads[pi], cells[ci])
-        pi, ci = pi[inside], ci[inside]
+        size = np.asarray(self.target.size, dtype=float)
+        pi, ci = _in_frame(view, pts, heads, cells, size, pi, ci)
+        big = predict_pixels(view, pts[pi], heads[pi], cells[ci], size, None) >= view.min_pixels
+        pi, ci = pi[big], ci[big]  # a target there would show enough pixels, if in sight
         if len(pi) == 0:
             return 0.0
         seen = np.zeros(len(cells), dtype=bool)
@@ -114,6 +138,17 @@ class GeometricSensor:
             clear = self.scene.line_of_sight(pts[pi[todo]], cells[ci[todo]])
             seen[ci[todo][clear]] = True
         return float(seen.mean())
+
+
+def _in_frame(view: View, eyes: FloatArray, headings: FloatArray, centres: FloatArray,
+              size: FloatArray, ei: np.ndarray, ci: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs (eye ``ei[m]``, target box at ``centres[ci[m]]``) where any corner or the
+    centre of the box is in the camera's frame and reach."""
+    probes = centres[ci][:, None, :] + np.vstack([np.zeros(3), CORNERS])[None, :, :] * size
+    k = probes.shape[1]
+    inside = view.sees(np.repeat(eyes[ei], k, axis=0), np.repeat(headings[ei], k),
+                       probes.reshape(-1, 3)).reshape(len(ei), k).any(axis=1)
+    return ei[inside], ci[inside]
 
 
 def _sample_path(robot: Robot, points: FloatArray,

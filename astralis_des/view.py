@@ -21,25 +21,36 @@ LOOK_AROUND = 8  # headings a camera that pans a full turn looks along
 class View:
     """A pinhole camera's field of view on a robot: what the geometric model checks."""
 
-    range: float  # m
+    range: float | None  # m: a cap on the depth of what is detected; None: no cap
     fov_deg: float  # vertical
     aspect: float  # width / height: square pixels give the horizontal field of view
     pitch_deg: float  # 0 forward, 90 straight down
     gimbal: bool = True  # levelled, turned to the direction of travel
     look_around: bool = False  # pans a full turn while waiting in place
     position_noise: float = 0.0  # the estimate's error per axis, a share of the distance
+    pixels: tuple[int, int] = (320, 240)  # the frame's width and height
+    min_pixels: int = 40  # target pixels a detection needs (astralis_des.detection)
 
     @classmethod
-    def of_kind(cls, kind: str, aspect: float = 4 / 3, **changes: float) -> View:
+    def of_kind(cls, kind: str, pixels: tuple[int, int] = (320, 240), min_pixels: int = 40,
+                **changes: float) -> View:
         """A kind's default camera (``astralis_des.kinds``), with ``changes``."""
         from astralis_des.kinds import KIND_DEFAULTS
 
         d = KIND_DEFAULTS[kind].camera
-        values: dict[str, float] = {"range": d.range, "fov_deg": d.fov_deg,
-                                    "pitch_deg": d.pitch_deg, **changes}
-        return cls(values["range"], values["fov_deg"], aspect, values["pitch_deg"],
+        values: dict[str, float | None] = {"range": d.range, "fov_deg": d.fov_deg,
+                                           "pitch_deg": d.pitch_deg, **changes}
+        fov, pitch = values["fov_deg"], values["pitch_deg"]
+        assert fov is not None and pitch is not None
+        return cls(values["range"], fov, pixels[0] / pixels[1], pitch,
                    gimbal=d.gimbal, look_around=d.look_around,
-                   position_noise=values.get("position_noise", 0.0))
+                   position_noise=float(values.get("position_noise") or 0.0),
+                   pixels=pixels, min_pixels=min_pixels)
+
+    @cached_property
+    def focal(self) -> float:
+        """The focal length in pixels (square pixels)."""
+        return (self.pixels[1] / 2) / self.tan_v
 
     @cached_property
     def tan_v(self) -> float:
@@ -66,30 +77,49 @@ class View:
         z = np.einsum("ij,ij->i", d, forward)
         x = np.abs(np.einsum("ij,ij->i", d, right))
         y = np.abs(np.einsum("ij,ij->i", d, down))
-        near = np.einsum("ij,ij->i", d, d) <= self.range**2
+        near = np.einsum("ij,ij->i", d, d) <= self.reach**2
         result: FloatArray = near & (z > 1e-6) & (x <= z * self.tan_h) & (y <= z * self.tan_v)
         return result
 
+    @property
+    def reach(self) -> float:
+        """How far the camera can detect the target at all: its range cap, else the distance
+        at which a target seen square on shrinks to ``min_pixels``."""
+        if self.range is not None:
+            return self.range
+        from astralis_des.kinds import TARGET_FACE
+
+        return float(self.focal * math.sqrt(TARGET_FACE / self.min_pixels))
+
     def swath(self, drop: float) -> float:
-        """Width across the direction of travel of what the camera sees on a plane ``drop``
-        metres below it (to 1 cm): moving ahead, it sweeps a strip this wide."""
+        """Width across the direction of travel within which a target whose centre is
+        ``drop`` metres below the camera shows enough pixels to be detected at some point of
+        a straight pass (to 1 cm): moving ahead, the camera searches a strip this wide."""
         return _swath(self, round(drop, 3))
 
 
 @lru_cache(maxsize=64)
 def _swath(view: View, drop: float) -> float:
-    steps = int(2 * view.range / 0.01) + 1
-    xs = np.linspace(-view.range, view.range, steps)
-    widths = []
-    for x in xs[::4]:  # rows across the track, 4 cm apart along it
-        pts = np.column_stack([np.full(steps, x), xs, np.full(steps, -drop)])
-        seen = view.sees(np.zeros((steps, 3)), np.zeros(steps), pts)
-        if seen.any():
-            widths.append(xs[seen])
-    if not widths:
+    from astralis_des.detection import predict_pixels
+    from astralis_des.kinds import TARGET_SIZE
+
+    reach = min(view.reach, 4.0 * max(drop, 0.5))
+    xs = np.arange(-reach, reach + 1e-9, 0.05)  # along the track
+
+    def widest(ys: FloatArray) -> float | None:
+        """The largest offset across the track in ``ys`` at which the target is detected."""
+        gx, gy = np.meshgrid(xs, ys, indexing="ij")
+        centres = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, -drop)])
+        pixels = predict_pixels(view, np.zeros((len(centres), 3)), np.zeros(len(centres)),
+                                centres, np.asarray(TARGET_SIZE), None).reshape(gx.shape)
+        seen = (pixels >= view.min_pixels).any(axis=0)
+        return float(ys[seen].max()) if seen.any() else None
+
+    coarse = widest(np.arange(0.0, reach + 1e-9, 0.1))
+    if coarse is None:
         return 0.0
-    ys = np.concatenate(widths)
-    return float(ys.max() - ys.min())
+    fine = widest(np.arange(coarse, coarse + 0.1, 0.01))
+    return round(2 * (fine if fine is not None else coarse), 2)
 
 
 def travel_headings(points: FloatArray, initial: float) -> FloatArray:

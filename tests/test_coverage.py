@@ -7,8 +7,11 @@ import pytest
 
 from astralis_des.actions import coverage as cov
 from astralis_des.actions.common import footprint_spacing
+from astralis_des.actions.uav import WALL_MARGIN
+from astralis_des.detection import predict_pixels
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kernel.scene import Scene
+from astralis_des.kinds import TARGET_SIZE
 from astralis_des.sensing import GeometricSensor
 from astralis_des.view import View
 from astralis_des.world.catalogue import default_catalogue
@@ -26,7 +29,7 @@ def sensor(world: World, target: tuple[float, float, float] | None = None,
 
 
 def robot(kind: str = "uav", height: float = 1.5, heading: float = 0.0) -> Robot:
-    """A robot with its kind's camera (UAV: 2 m, 60 degrees down; UGV: 6 m, ahead)."""
+    """A robot with its kind's camera (UAV: 75 degrees down; UGV: ahead; no range cap)."""
     return Robot("r", kind, 1.0, View.of_kind(kind), height, np.zeros(3), heading=heading)
 
 
@@ -55,10 +58,21 @@ def test_lawnmower_lanes_follow_their_axis(axis: int) -> None:
 
 
 def test_spacing_follows_the_footprint() -> None:
-    """A UAV camera 1 m above the target's plane, 75 degrees down, 90 x 106 degrees, 2 m
-    reach sees a strip 3.1 m wide (the frustum's side meets the reach at x = 0.768 m,
-    y = 1.553 m); passes with 20% overlap are 2.48 m apart."""
-    assert footprint_spacing(robot(), 0.2) == pytest.approx(2 * 1.553 * 0.8, abs=0.03)
+    """Passes are 80% of the strip a UAV camera 1 m above the target's centre searches: a
+    sitting target 1 cm inside half of it across the track shows 40 pixels somewhere along a
+    pass, one 5 cm outside never does (90 x 106 degrees, 75 down, 320 x 240: about 5.5 m)."""
+    view = View.of_kind("uav")
+    strip = view.swath(1.0)
+    assert 5.0 < strip < 6.0
+    assert footprint_spacing(robot(), 0.2) == pytest.approx(0.8 * strip)
+    along = np.arange(-4.0, 4.0, 0.01)
+
+    def most(across: float) -> float:
+        centres = np.column_stack([along, np.full(len(along), across), np.full(len(along), -1.0)])
+        return float(predict_pixels(view, np.zeros((len(along), 3)), np.zeros(len(along)),
+                                    centres, np.array(TARGET_SIZE), None).max())
+
+    assert most(strip / 2 - 0.01) >= 40 > most(strip / 2 + 0.05)
 
 
 def test_the_uav_camera_sees_ahead_and_below_not_behind() -> None:
@@ -74,8 +88,8 @@ def test_the_uav_camera_sees_ahead_and_below_not_behind() -> None:
 
 def test_the_ugv_camera_sees_a_75_degree_wedge_ahead() -> None:
     """A 60 degree vertical field of view at 4:3 is 75.2 degrees across: 37 degrees off the
-    axis is in, 39 is out; 5.9 m is in, 6.1 m is out."""
-    view = View.of_kind("ugv")
+    axis is in, 39 is out; with a 6 m range cap, 5.9 m is in, 6.1 m is out."""
+    view = View.of_kind("ugv", range=6.0)
     eye = np.zeros((4, 3))
     angles = np.radians([37.0, 39.0, 0.0, 0.0])
     reach = np.array([3.0, 3.0, 5.9, 6.1])
@@ -85,15 +99,16 @@ def test_the_ugv_camera_sees_a_75_degree_wedge_ahead() -> None:
 
 @pytest.mark.parametrize("pattern", ["spiral_in", "spiral_out", "sweep_x", "sweep_y"])
 def test_uav_patterns_cover_at_least_90_percent(world: World, pattern: str) -> None:
-    """Each UAV search pattern sees >= 90% of an empty room's floor."""
+    """Each UAV search pattern (its outer pass at most 1 m from the walls) sees >= 90% of an
+    empty room's floor."""
     room = world.rooms["A.2.1.2"]
     r = robot()
     spacing = footprint_spacing(r, 0.2)
     plane = {
-        "spiral_in": lambda: cov.spiral(room.box, spacing, True),
-        "spiral_out": lambda: cov.spiral(room.box, spacing, False),
-        "sweep_x": lambda: cov.lawnmower(room.box, spacing, 0),
-        "sweep_y": lambda: cov.lawnmower(room.box, spacing, 1),
+        "spiral_in": lambda: cov.spiral(room.box, spacing, True, WALL_MARGIN),
+        "spiral_out": lambda: cov.spiral(room.box, spacing, False, WALL_MARGIN),
+        "sweep_x": lambda: cov.lawnmower(room.box, spacing, 0, WALL_MARGIN),
+        "sweep_y": lambda: cov.lawnmower(room.box, spacing, 1, WALL_MARGIN),
     }[pattern]()
     pts = np.column_stack([plane, np.full(len(plane), room.box.lo[2] + r.height)])
     share = sensor(world).coverage(r, pts, room)

@@ -58,7 +58,9 @@ def test_fig7_matches_the_kinematic_fidelity(fig7_physics: RunResult) -> None:
                 if e["kind"] == "task_finished" and e["status"] == "succeeded"}
 
     slow, fast = durations(fig7_physics), durations(kinematic)
-    assert set(slow) == set(fast) and len(fast) >= 4
+    # every action done in kinematic fidelity is done in physics too (the physics run may
+    # finish one more before its later detection)
+    assert set(fast) <= set(slow) and len(fast) >= 4
     for task, seconds in fast.items():
         assert abs(slow[task] - seconds) < max(0.2 * seconds, 1.0), (task, seconds, slow[task])
     # When the target is seen may differ more: in physics the UAVs hold for the patrolling

@@ -11,12 +11,14 @@ import numpy as np
 from astralis_des.world.geometry import Box, FloatArray
 
 
-def spiral(box: Box, spacing: float, inward: bool = True) -> FloatArray:
-    """Rectangular rings, outermost first, ``spacing`` apart; reversed when outward."""
+def spiral(box: Box, spacing: float, inward: bool = True,
+           margin: float | None = None) -> FloatArray:
+    """Rectangular rings, outermost first, ``spacing`` apart; reversed when outward. The
+    outermost ring runs ``spacing / 2`` inside the walls, or ``margin`` when that is nearer."""
     x0, y0, x1, y1 = box.lo[0], box.lo[1], box.hi[0], box.hi[1]
     half = min(x1 - x0, y1 - y0) / 2
     pts: list[tuple[float, float]] = []
-    k = min(spacing / 2, half)
+    k = min(spacing / 2, half, margin if margin is not None else np.inf)
     while k <= half + 1e-9:
         a, b, c, d = x0 + k, y0 + k, x1 - k, y1 - k
         if c - a < 1e-6 or d - b < 1e-6:  # the ring collapsed to a line: the spiral's centre
@@ -28,16 +30,23 @@ def spiral(box: Box, spacing: float, inward: bool = True) -> FloatArray:
     return path if inward else path[::-1].copy()
 
 
-def lawnmower(box: Box, spacing: float, axis: int) -> FloatArray:
-    """Back-and-forth lanes parallel to ``axis`` (0: x, "horizontal"; 1: y, "vertical")."""
+def lawnmower(box: Box, spacing: float, axis: int, margin: float | None = None) -> FloatArray:
+    """Back-and-forth lanes parallel to ``axis`` (0: x, "horizontal"; 1: y, "vertical"),
+    evenly spread; lanes end ``spacing / 2`` from the walls, or ``margin`` when nearer, and
+    the outer lanes keep within ``margin`` of the side walls too."""
     lo, hi = np.array(box.lo[:2]), np.array(box.hi[:2])
     across = 1 - axis
     width = hi[across] - lo[across]
     n = max(1, int(np.ceil(width / spacing)))
-    offsets = lo[across] + (np.arange(n) + 0.5) * width / n
+    inset = min(spacing / 2, margin if margin is not None else np.inf)
+    if n == 1:
+        offsets = np.array([lo[across] + width / 2])
+    else:
+        side = min(width / (2 * n), inset)
+        offsets = np.linspace(lo[across] + side, hi[across] - side, n)
     pts = []
     for i, off in enumerate(offsets):
-        ends = (lo[axis] + spacing / 2, hi[axis] - spacing / 2)
+        ends = (lo[axis] + inset, hi[axis] - inset)
         ends = ends if i % 2 == 0 else ends[::-1]
         for e in ends:
             p = np.empty(2)

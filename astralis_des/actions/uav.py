@@ -20,6 +20,8 @@ from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task, TaskStatus
 
 OVERLAP = 0.2  # share of the footprint that neighbouring passes see twice
+WALL_MARGIN = 1.0  # m: the outermost pass runs at most this far inside the walls, so that the
+# camera, which looks ahead and down, sees the strip along each wall
 
 
 @ACTIONS.register(("uav", "hover"))
@@ -37,9 +39,9 @@ def _pattern(name: str, inward: bool | None = None, axis: int | None = None):  #
             return failed(f"{name} needs a room")
         spacing = float(task.param("spacing", footprint_spacing(robot, OVERLAP)))
         if axis is None:
-            plane = cov.spiral(room.box, spacing, inward=bool(inward))
+            plane = cov.spiral(room.box, spacing, inward=bool(inward), margin=WALL_MARGIN)
         else:
-            plane = cov.lawnmower(room.box, spacing, axis)
+            plane = cov.lawnmower(room.box, spacing, axis, margin=WALL_MARGIN)
         entry = room.door_point("room")
         plane = cov.start_near(plane, room.box, entry)  # type: ignore[arg-type]
         return (yield from search_path(ctx, robot, room, plane_to_floor(room, plane), name))

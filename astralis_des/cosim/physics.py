@@ -103,13 +103,11 @@ class PhysicsCoSim:
             self._furnish(room_id, scene.clutter(room_id), movers=False)
         scene.listeners.append(self._furnish)
         self.target = target = sim.target
+        self.target_size = np.asarray(target.size, dtype=float)
         if target.mover is None:
-            w, d = (1.8, 0.6) if target.avatar.get("activity") == "laying" else (0.5, 0.5)
-            self.target_size = np.array([w, d, 2 * 0.5])
             self.target_body = self.client.add_box(target.start, self.target_size)
             self.names[self.target_body] = "target"
         else:
-            self.target_size = np.asarray(target.mover.size, dtype=float)
             self.target_body = next(b for m, b in self.movers if m is target.mover)
 
     def target_now(self, now: float) -> tuple[int, FloatArray, FloatArray]:

@@ -41,6 +41,8 @@ class RunResult:
     rooms_searched: list[str]
     coverage: dict[str, float]
     events: list[Record] = field(repr=False)
+    # per searched room: its status, the most of it one search saw, and each search
+    rooms: dict[str, dict[str, Any]] = field(default_factory=dict)
     sensor_calls: dict[str, int] = field(default_factory=dict)  # physics: looks, renders, scans
     wall_time: float = 0.0
     sensor_time: dict[str, float] = field(default_factory=dict)  # wall s per sensor (physics)
@@ -75,6 +77,7 @@ def build_result(sim: Simulation, outcome: str, wall_time: float) -> RunResult:
     coverage = {task.room: float(res.coverage) for task, res in sim.finished
                 if task.room and res.coverage is not None and res.ok}
     detection = next((r for r in sim.log.records if r["kind"] == "detection"), None)
+    rooms = room_report(sim)
     target = {"room": sim.target.room, "position": list(sim.target.position),
               **sim.target.avatar}
     clock = getattr(getattr(sim.cosim, "perception", None), "clock", None)
@@ -84,6 +87,30 @@ def build_result(sim: Simulation, outcome: str, wall_time: float) -> RunResult:
         time_to_find=detection["t"] if detection else None,
         found_by=detection["robot"] if detection else None, target=target, robots=stats,
         rounds=sim.rounds, rooms_searched=list(sim.searched), coverage=coverage,
-        events=sim.log.records, wall_time=wall_time,
+        events=sim.log.records, rooms=rooms, wall_time=wall_time,
         sensor_calls=dict(sorted(clock.calls.items())) if clock else {},
         sensor_time=dict(sorted(clock.seconds.items())) if clock else {})
+
+
+def room_report(sim: Simulation) -> dict[str, dict[str, Any]]:
+    """Each room of the searched segments: ``searched`` (seen at least ``min_coverage``),
+    ``undercovered`` (counted searched though no search saw that much: no agent of another
+    kind was left), ``given_up``, or ``not_searched``; the most of it one search saw, and who
+    searched it how (so that "hidden by furniture" can be told from "never looked")."""
+    given_up = {r["room"] for r in sim.log.records if r["kind"] == "room_given_up"}
+    threshold = sim.mission.spec.assignment.min_coverage
+    report: dict[str, dict[str, Any]] = {}
+    for room in sim.mission.searched_rooms():
+        searches = [{"robot": task.robot, "kind": sim.robots[task.robot].kind,
+                     "action": task.action, "status": res.status.value,
+                     "coverage": res.coverage}
+                    for task, res in sim.finished if task.room == room and task.action != "move"]
+        seen = [float(res.coverage) for task, res in sim.finished
+                if task.room == room and task.action != "move" and res.coverage is not None]
+        best = max(seen) if seen else None
+        if room in sim.searched:
+            status = "searched" if best is None or best >= threshold else "undercovered"
+        else:
+            status = "given_up" if room in given_up else "not_searched"
+        report[room] = {"status": status, "coverage": best, "searches": searches}
+    return report

@@ -73,6 +73,7 @@ class Target:
     avatar: dict[str, Any]
     start: tuple[float, float, float]  # centre of the body at t = 0
     mover: Mover | None = None
+    size: tuple[float, float, float] = STANDING + (2 * TARGET_HEIGHT,)  # its box, m
 
     @property
     def position(self) -> tuple[float, float, float]:
@@ -203,7 +204,9 @@ class Scene:
             height = AVATAR_HEIGHTS.get(str(avatar.get("height")), 1.72)
             mover = self._patrol("target", room_id, position, (w, d, height),
                                  tuple(avatar.items()))
-        self.target = Target(room_id, dict(avatar), position, mover)
+        size = mover.size if mover is not None else (w, d, 2 * TARGET_HEIGHT)
+        self.target = Target(room_id, dict(avatar), position, mover,
+                             tuple(float(v) for v in size))  # type: ignore[arg-type]
         return self.target
 
     def _patrol(self, ident: str, room_id: str, where: tuple[float, ...],

@@ -61,6 +61,7 @@ class Simulation:
         self.found = self.env.event()
         self.rounds: list[dict[str, Any]] = []
         self.searched: list[str] = []
+        self.tried: dict[str, set[str]] = {}  # room -> kinds whose search saw too little of it
         self.finished: list[tuple[Task, ActionResult]] = []
         self.out_dir = Path(out_dir) if out_dir is not None else None
         self._progress = progress
@@ -174,13 +175,18 @@ class Simulation:
         self.log.emit("recover", robot.id)
 
     # -- assignment ------------------------------------------------------------------------
-    def assignment_round(self, segment: str, rooms: list[str], robots: list[Robot]) -> Assignment:
+    def assignment_round(self, segment: str, rooms: list[str], robots: list[Robot],
+                         exclude: dict[str, set[str]] | None = None) -> Assignment:
+        """Match ``robots`` to ``rooms``; ``exclude`` names the kinds that may not take a room
+        (they searched it and saw too little)."""
         cfg = self.mission.spec.assignment
+        exclude = exclude or {}
         agents = [Agent(r.id, r.kind, _xyz(r.position(self.env.now))) for r in robots]
         infos = [RoomInfo(rid, self.world.rooms[rid].center, self.rooms[rid].risk,
                           self.rooms[rid].messiness) for rid in rooms]
         weights = Weights(cfg.weights.risk.model_dump(), cfg.weights.messiness.model_dump())
-        reachable = np.array([[self._reaches(robot, rid) for rid in rooms] for robot in robots])
+        reachable = np.array([[robot.kind not in exclude.get(rid, ()) and
+                               self._reaches(robot, rid) for rid in rooms] for robot in robots])
         plan = assign(agents, infos, weights, strategy=cfg.strategy, solver=cfg.solver,
                       high_risk=cfg.high_risk, high_messiness=cfg.high_messiness,
                       reachable=reachable)
@@ -296,7 +302,7 @@ def view_of(member: MemberSpec) -> View | None:
         return None
     set_here = {k: v for k, v in (("range", camera.range), ("fov_deg", camera.fov_deg),
                                   ("pitch_deg", camera.pitch_deg)) if v is not None}
-    return View.of_kind(member.kind, camera.width / camera.height,
+    return View.of_kind(member.kind, (camera.width, camera.height), camera.min_pixels,
                         position_noise=camera.position_noise, **set_here)
 
 

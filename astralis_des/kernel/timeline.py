@@ -31,12 +31,15 @@ def search(sim: Simulation) -> Generator[simpy.Event, Any, str]:
 
     A room whose search failed (no route, stuck) stays pending for the next round, up to
     ``max_attempts`` rounds; one whose searcher broke down (a fault, a crash) stays pending
-    without using an attempt. Returns why the search stopped.
+    without using an attempt. A search that saw less of the room than ``min_coverage`` leaves
+    it pending for an agent of a kind that has not searched it yet; when no such agent is
+    left, the room counts as searched as far as the team could see it. Returns why the search
+    stopped.
     """
     attempts: Counter[str] = Counter()
-    max_attempts = sim.mission.spec.assignment.max_attempts
-    if sim.mission.spec.assignment.start_at > 0:
-        yield sim.env.timeout(sim.mission.spec.assignment.start_at)
+    spec = sim.mission.spec.assignment
+    if spec.start_at > 0:
+        yield sim.env.timeout(spec.start_at)
     for segment in sim.mission.searched_segments():
         pending = list(sim.world.segments[segment].rooms)
         while pending:
@@ -44,23 +47,51 @@ def search(sim: Simulation) -> Generator[simpy.Event, Any, str]:
             if not agents:
                 sim.log.emit("team_lost", segment=segment)
                 return "team_lost"
-            plan = sim.assignment_round(segment, pending, agents)
+            plan = sim.assignment_round(segment, pending, agents, exclude=sim.tried)
+            if not plan.pairs:  # no agent may take any pending room: settle them
+                for room in list(pending):
+                    _settle(sim, room, "no agent left that can search it")
+                    pending.remove(room)
+                break
             searches = dispatch(sim, plan)
             yield simpy.AllOf(sim.env, list(searches.values()))
             searcher = {p.room: p.agent for p in plan.pairs}
             for room, done in searches.items():
                 outcome = cast(ActionResult, done.value)
-                if outcome.ok:
+                robot = sim.robots[searcher[room]]
+                if outcome.ok and not _undercovered(sim, room, robot, outcome):
                     pending.remove(room)
                     sim.searched.append(room)
                     continue
-                if sim.robots[searcher[room]].faulted:
-                    continue  # the robot broke, not the room: another takes it next round
+                if outcome.ok or robot.faulted:
+                    continue  # seen too little, or the robot broke: another takes it next round
                 attempts[room] += 1
-                if attempts[room] >= max_attempts:
+                if attempts[room] >= spec.max_attempts:
                     pending.remove(room)
                     sim.log.emit("room_given_up", room=room, attempts=attempts[room])
     return "not_found"
+
+
+def _undercovered(sim: Simulation, room: str, robot: Any, outcome: ActionResult) -> bool:
+    """Whether a search that succeeded saw too little of ``room`` and another kind of agent
+    can still search it; a ``room_undercovered`` event says so either way."""
+    threshold = sim.mission.spec.assignment.min_coverage
+    if outcome.coverage is None or outcome.coverage >= threshold:
+        return False
+    sim.tried.setdefault(room, set()).add(robot.kind)
+    others = sorted({r.kind for r in sim.robots.values() if not r.faulted} - sim.tried[room])
+    sim.log.emit("room_undercovered", robot.id, room=room, coverage=outcome.coverage,
+                 threshold=threshold, requeued=bool(others), kinds_left=others)
+    return bool(others)
+
+
+def _settle(sim: Simulation, room: str, why: str) -> None:
+    """A pending room no agent may take: searched as far as seen, if it was; else given up."""
+    if room in sim.tried:
+        sim.searched.append(room)
+        sim.log.emit("room_searched_undercovered", room=room, reason=why)
+    else:
+        sim.log.emit("room_given_up", room=room, attempts=0, reason=why)
 
 
 def dispatch(sim: Simulation, plan: Assignment) -> dict[str, simpy.Event]:

@@ -171,6 +171,10 @@ class AssignmentSpec(Strict):
         default_factory=lambda: ["A"], min_length=1,
         description="buildings or segment ids to search, in order; each round takes one segment")
     max_attempts: int = Field(2, ge=1, description="rounds a room may be tried in")
+    min_coverage: Unit = Field(
+        0.9, description="share of a room's free floor a search must see for the room to count "
+        "as searched; below it the room goes back to the pending set, for an agent of a kind "
+        "that has not searched it yet")
     start_at: NonNegativeFloat = Field(0.0, description="s the team waits before round 1")
     auto: bool = Field(True, description="run the rounds of `search` on their own; false: the "
                        "team waits for commands (astralis serve, chat)")

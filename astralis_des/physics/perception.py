@@ -2,9 +2,11 @@
 
 - **Cameras** look ``rate`` times a second while an action searches, and once (around, for a
   camera that pans) when a robot waits in place. A look first tests whether the target's box
-  lies in the camera's frustum and range at all (microseconds); only then is a frame rendered
-  (about 30 ms at 320 x 240), and the target is detected when at least ``min_pixels`` of its
-  segmentation lie within range. The estimate is the centroid of those pixels' depth points.
+  lies in the camera's frustum at all, and whether it could show enough pixels if nothing hid
+  it (the shared detection model, :mod:`astralis_des.detection`; microseconds); only then is
+  a frame rendered (about 30 ms at 320 x 240), and the target is detected when at least
+  ``min_pixels`` of its segmentation show (within range, when the camera has one). The
+  estimate is the centroid of those pixels' depth points.
   Frames are kept for the recording at ``record_rate``, rendered at half resolution.
 - **Lidars** scan at their rate while their robot moves; a UGV slows down for the nearest
   return ahead of it (the local planner's safety bubble).
@@ -26,6 +28,7 @@ import numpy as np
 import simpy
 from numpy.typing import NDArray
 
+from astralis_des.detection import predict_pixels
 from astralis_des.kernel.robot import Robot
 from astralis_des.mission.spec import CameraSpec, ImuSpec, LidarSpec
 from astralis_des.physics.sensors import Camera, Frame, Imu, ImuReading, Intrinsics, Lidar2D
@@ -43,6 +46,8 @@ SLOW_AT = 1.5  # m from the lidar: nearer than this ahead, a UGV slows down ...
 STOP_AT = 0.7  # m: ... to CREEP of its speed here
 CREEP = 0.3
 LIDAR_OFFSET = {"ugv": 0.6, "uav": 0.5}  # m: rays start outside the body
+CULL = 0.5  # no frame is rendered when the target, unhidden, would show less than this share
+# of the pixels a detection needs (the shared detection model's prediction)
 
 
 @dataclass
@@ -97,10 +102,11 @@ class Eyes:
         body = cosim.drivers[robot.id].body
         mount = _mount(cosim, robot.id)
         self.spec, self.view = spec, view
-        k = Intrinsics(spec.width, spec.height, view.fov_deg, far=view.range + 1.0)
+        far = 2.0 * view.reach + 1.0  # past any detection, off-axis views included
+        k = Intrinsics(spec.width, spec.height, view.fov_deg, far=far)
         self.full = Camera(cosim.client, body, k, mount, view.pitch_deg)
         small = Intrinsics(max(spec.width // 2, 1), max(spec.height // 2, 1), view.fov_deg,
-                           far=view.range + 1.0)
+                           far=far)
         self.small = Camera(cosim.client, body, small, mount, view.pitch_deg)
         self.next_keep = 0.0
 
@@ -191,7 +197,9 @@ class Perception:
                 heading = math.atan2(rotation[1, 2], rotation[0, 2])
                 inside = eyes.view.sees(np.repeat(eye[None, :], len(probe), axis=0),
                                         np.full(len(probe), heading), probe)
-            if not inside.any():
+            if not inside.any() or predict_pixels(
+                    eyes.view, eye[None, :], np.array([heading]), centre[None, :], size,
+                    None)[0] < CULL * eyes.view.min_pixels:
                 continue
             with self.clock.timed("camera"):
                 frame = eyes.full.capture(now, yaw)
@@ -202,7 +210,9 @@ class Perception:
         return None
 
     def _detect(self, frame: Frame, body: int, eyes: Eyes, centre: FloatArray) -> Sighting | None:
-        mask = (frame.segmentation == body) & (frame.depth <= eyes.view.range)
+        mask = frame.segmentation == body
+        if eyes.view.range is not None:
+            mask &= frame.depth <= eyes.view.range
         pixels = int(np.count_nonzero(mask))
         if pixels < eyes.spec.min_pixels:
             return None

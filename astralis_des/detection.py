@@ -1,0 +1,106 @@
+"""The detection model both fidelities share: how many pixels of the target a camera shows.
+
+A detector (a person detector on the camera's frames) needs the target to cover at least
+``min_pixels`` of the frame, within the camera's ``range`` when one is set. The physics
+fidelity counts those pixels in the rendered segmentation; the kinematic fidelity predicts
+them here, from the same camera (intrinsics, pose) and the same target box:
+
+- the box's **image area**, unoccluded: each face that turns to the camera is sampled on a
+  ``SAMPLES`` x ``SAMPLES`` grid, and each sample stands for its share of the face's area seen
+  along the ray, which covers ``f^2 r / z^3`` pixels per square metre (``f`` the focal length
+  in pixels, ``r`` the distance and ``z`` the depth along the optical axis);
+- its **visible share**: only samples inside the image, within range and with a clear line of
+  sight (walls, slabs, furniture, other avatars) count.
+
+The prediction is the sum over the samples that count, so a target half behind a table
+shows about half its pixels, one at the frame's edge the part inside it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from astralis_des.view import View
+from astralis_des.world.geometry import FloatArray
+
+SAMPLES = 3  # per side of each face
+NEAR = 0.05  # m: the renderer's near plane
+Sight = Callable[[FloatArray, FloatArray], np.ndarray]  # (eyes, points) -> clear
+
+
+def _face_grid() -> FloatArray:
+    """Sample offsets on a box's faces in units of its half size, ``(3, n*n, 3)``: the faces
+    normal to x, y and z (the side of each is set per look)."""
+    ticks = (np.arange(SAMPLES) + 0.5) / SAMPLES * 2 - 1
+    a, b = np.meshgrid(ticks, ticks, indexing="ij")
+    grids = np.zeros((3, SAMPLES * SAMPLES, 3))
+    for axis in range(3):
+        others = [k for k in range(3) if k != axis]
+        grids[axis, :, others[0]], grids[axis, :, others[1]] = a.ravel(), b.ravel()
+        grids[axis, :, axis] = 1.0
+    return grids
+
+
+GRID = _face_grid()
+
+
+def target_samples(eyes: FloatArray, centres: FloatArray,
+                   size: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Sample points on the faces of each target box that turn to its eye, ``(M, K, 3)``, and
+    each sample's area seen along the ray from the eye, ``(M, K)`` square metres."""
+    half = np.asarray(size, dtype=float) / 2
+    d = centres - eyes
+    toward = -np.sign(d)  # the face of each axis that looks back at the eye
+    toward[toward == 0] = 1.0
+    k = SAMPLES * SAMPLES
+    offsets = GRID[None, :, :, :] * half  # (1, 3, k, 3)
+    offsets = np.where(np.eye(3, dtype=bool)[None, :, None, :],
+                       offsets * toward[:, None, None, :], offsets)
+    points = centres[:, None, None, :] + offsets  # (M, 3, k, 3)
+    face_area = np.array([half[1] * half[2], half[0] * half[2], half[0] * half[1]]) * 4 / k
+    rays = points - eyes[:, None, None, :]
+    r = np.linalg.norm(rays, axis=3)
+    along_normal = np.stack([rays[:, a, :, a] for a in range(3)], axis=1)
+    cos = np.abs(along_normal) / np.maximum(r, 1e-9)
+    # a face seen edge-on, or from behind its own box (the eye inside the slab), shows nothing
+    facing = (np.abs(d) > half)[:, :, None]
+    area = np.where(facing, face_area[None, :, None] * cos, 0.0)
+    return points.reshape(len(eyes), 3 * k, 3), area.reshape(len(eyes), 3 * k)
+
+
+def predict_pixels(view: View, eyes: FloatArray, headings: FloatArray, centres: FloatArray,
+                   size: FloatArray, sight: Sight | None) -> FloatArray:
+    """The target's pixels in the frame of each camera (``eyes[m]`` facing ``headings[m]``,
+    the target's box at ``centres[m]``): unoccluded when ``sight`` is None, else counting only
+    the samples it calls clear."""
+    eyes = np.atleast_2d(np.asarray(eyes, dtype=float))
+    centres = np.atleast_2d(np.asarray(centres, dtype=float))
+    if len(eyes) == 0:
+        return np.zeros(0)
+    points, area = target_samples(eyes, centres, size)
+    right, down, forward = view.axes(np.asarray(headings, dtype=float))
+    rays = points - eyes[:, None, :]
+    x = np.einsum("mkj,mj->mk", rays, right)
+    y = np.einsum("mkj,mj->mk", rays, down)
+    z = np.einsum("mkj,mj->mk", rays, forward)
+    inside = (z > NEAR) & (np.abs(x) <= z * view.tan_h) & (np.abs(y) <= z * view.tan_v)
+    if view.range is not None:
+        inside &= z <= view.range
+    inside &= area > 0
+    zc = np.maximum(z, NEAR)
+    r = np.linalg.norm(rays, axis=2)
+    pixels_each = area * view.focal**2 * r / zc**3
+    if sight is not None and inside.any():
+        m, kk = np.nonzero(inside)
+        clear = sight(eyes[m], points[m, kk])
+        inside[m[~clear], kk[~clear]] = False
+    out: FloatArray = np.minimum((pixels_each * inside).sum(axis=1),
+                                 float(view.pixels[0] * view.pixels[1]))
+    return out
+
+
+def detects(view: View, pixels: FloatArray) -> np.ndarray:
+    """Which predicted (or counted) pixel totals make a detection."""
+    return np.asarray(pixels) >= view.min_pixels
