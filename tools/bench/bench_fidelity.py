@@ -111,6 +111,10 @@ def agreement(rows: list[dict[str, Any]]) -> list[str]:
     finder = sum(k["outcome"] == p["outcome"] and k["found_by"] == p["found_by"]
                  for k, p in pairs)
     searched = sum(k["rooms_searched"] == p["rooms_searched"] for k, p in pairs)
+    timed = sum(k["outcome"] == p["outcome"] and k["found_by"] == p["found_by"] and (
+        k["time_to_find"] is None or p["time_to_find"] is None
+        or abs(p["time_to_find"] - k["time_to_find"]) <= 0.2 * k["time_to_find"])
+        for k, p in pairs)
     kin = sum(k["outcome"] == "found" for k, _ in pairs)
     phy = sum(p["outcome"] == "found" for _, p in pairs)
     return [
@@ -119,6 +123,7 @@ def agreement(rows: list[dict[str, Any]]) -> list[str]:
         f"({(phy - kin) / n * 100:+.0f} points)",
         f"same outcome: {outcome / n:.0%}; same outcome and finder: {finder / n:.0%}; "
         f"same rooms searched: {searched / n:.0%}",
+        f"same detection (outcome, finder, time to find within 20%): {timed / n:.0%}",
     ]
 
 
