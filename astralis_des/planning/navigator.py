@@ -105,30 +105,14 @@ class Navigator:
         return Route(np.array(out), skipped=skipped)
 
     def usable(self, robot: Robot, points: FloatArray) -> FloatArray:
-        """The points of a coverage path the robot's body fits at (the others dropped), in
-        either method: a search reports the same coverage whichever way its robot plans. On
-        the graph a UAV's points are tested against the walls and furniture themselves (no
-        voxel map is built for straight legs)."""
+        """The points of a coverage path the robot's body fits at (the others dropped). A
+        walker's and the UGV's are checked in either method, on their floor's grid (cheap), so
+        that a search reports the same coverage whichever way its robot plans; a UAV's only
+        with the map (on the graph no voxel map is built, and its legs fly straight)."""
         if self.method == "graph" and robot.kind == "uav":
-            ok = self._fits_boxes(robot, np.atleast_2d(np.asarray(points, dtype=float)))
-        else:
-            ok = self.fits(robot, points)
+            return points
+        ok = self.fits(robot, points)
         return points[ok] if ok.any() else points[:0]
-
-    def _fits_boxes(self, robot: Robot, pts: FloatArray) -> np.ndarray:
-        radius = BODY_RADIUS[robot.kind] + self.cfg.margin
-        reach = radius + KEEP_OUT[robot.kind]
-        lo, hi = pts.min(axis=0) - reach, pts.max(axis=0) + reach
-        solids = self.world.solid_array
-        near = np.all((solids[:, 0] <= hi) & (solids[:, 1] >= lo), axis=1)
-        furniture = self._furniture(lo, hi)
-        boxes = np.concatenate([solids[near] - [[-radius] * 3, [radius] * 3],
-                                furniture - [[-reach] * 3, [reach] * 3]])
-        if not len(boxes):
-            return np.ones(len(pts), dtype=bool)
-        inside = np.all((pts[:, None, :] >= boxes[None, :, 0]) &
-                        (pts[:, None, :] <= boxes[None, :, 1]), axis=2).any(axis=1)
-        return np.asarray(~inside)
 
     def fits(self, robot: Robot, points: FloatArray) -> np.ndarray:
         """Where (``points`` at its sensor height) the robot's body is clear, by the check its
