@@ -100,7 +100,3 @@ def predict_pixels(view: View, eyes: FloatArray, headings: FloatArray, centres: 
                                  float(view.pixels[0] * view.pixels[1]))
     return out
 
-
-def detects(view: View, pixels: FloatArray) -> np.ndarray:
-    """Which predicted (or counted) pixel totals make a detection."""
-    return np.asarray(pixels) >= view.min_pixels

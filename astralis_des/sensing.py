@@ -79,7 +79,7 @@ class GeometricSensor:
         # cheap tests first: can any corner of the box be in the frame, and would the box
         # show enough pixels if nothing hid it?
         every = np.arange(len(pts))
-        near, _ = _in_frame(view, pts, headings, targets, size, every, every)
+        near, _ = in_frame(view, pts, headings, targets, size, every, every)
         if len(near) == 0:
             return None
         bound = predict_pixels(view, pts[near], headings[near], targets[near], size, None)
@@ -122,7 +122,7 @@ class GeometricSensor:
         pi = np.repeat(np.arange(len(pts)), len(cells))
         ci = np.tile(np.arange(len(cells)), len(pts))
         size = np.asarray(self.target.size, dtype=float)
-        pi, ci = _in_frame(view, pts, heads, cells, size, pi, ci)
+        pi, ci = in_frame(view, pts, heads, cells, size, pi, ci)
         big = predict_pixels(view, pts[pi], heads[pi], cells[ci], size, None) >= view.min_pixels
         pi, ci = pi[big], ci[big]  # a target there would show enough pixels, if in sight
         if len(pi) == 0:
@@ -140,7 +140,7 @@ class GeometricSensor:
         return float(seen.mean())
 
 
-def _in_frame(view: View, eyes: FloatArray, headings: FloatArray, centres: FloatArray,
+def in_frame(view: View, eyes: FloatArray, headings: FloatArray, centres: FloatArray,
               size: FloatArray, ei: np.ndarray, ci: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The pairs (eye ``ei[m]``, target box at ``centres[ci[m]]``) where any corner or the
     centre of the box is in the camera's frame and reach."""

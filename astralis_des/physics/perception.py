@@ -32,7 +32,7 @@ from astralis_des.detection import predict_pixels
 from astralis_des.kernel.robot import Robot
 from astralis_des.mission.spec import CameraSpec, ImuSpec, LidarSpec
 from astralis_des.physics.sensors import Camera, Frame, Imu, ImuReading, Intrinsics, Lidar2D
-from astralis_des.sensing import Sighting
+from astralis_des.sensing import Sighting, in_frame
 from astralis_des.streams import stream
 from astralis_des.view import View, look_headings
 from astralis_des.world.geometry import FloatArray
@@ -188,16 +188,14 @@ class Perception:
             with self.clock.timed("camera"):
                 self._keep(robot.id, eyes.small.capture(now, yaws[0]), detection=False)
         body, centre, size = self.cosim.target_now(now)
-        corners = centre + np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5])
-                                    ).reshape(3, -1).T * np.asarray(size)
-        probe = np.vstack([centre[None, :], corners])
+        one = np.zeros(1, dtype=int)
         for yaw in yaws:
             with self.clock.timed("camera_cull"):
                 eye, rotation = eyes.full.pose(yaw)
                 heading = math.atan2(rotation[1, 2], rotation[0, 2])
-                inside = eyes.view.sees(np.repeat(eye[None, :], len(probe), axis=0),
-                                        np.full(len(probe), heading), probe)
-            if not inside.any() or predict_pixels(
+                inside, _ = in_frame(eyes.view, eye[None, :], np.array([heading]),
+                                     centre[None, :], np.asarray(size), one, one)
+            if not len(inside) or predict_pixels(
                     eyes.view, eye[None, :], np.array([heading]), centre[None, :], size,
                     None)[0] < CULL * eyes.view.min_pixels:
                 continue

@@ -59,7 +59,7 @@ def looks(robot: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def classify(sim: Any) -> str:
     """Why the target was never detected (see the module's docstring)."""
     from astralis_des.detection import predict_pixels
-    from astralis_des.sensing import CORNERS
+    from astralis_des.sensing import in_frame
     from astralis_des.world.geometry import segments_hit_boxes
 
     stage = 0
@@ -72,15 +72,12 @@ def classify(sim: Any) -> str:
         if not len(pts):
             continue
         targets = sim.target.positions_at(times)
-        probes = np.concatenate([targets[:, None, :],
-                                 targets[:, None, :] + CORNERS[None] * size], axis=1)
-        inside = robot.view.sees(np.repeat(pts, 9, axis=0), np.repeat(heads, 9),
-                                 probes.reshape(-1, 3)).reshape(len(pts), 9).any(axis=1)
-        if not inside.any():
+        every = np.arange(len(pts))
+        view = robot.view
+        i, _ = in_frame(view, pts, heads, targets, size, every, every)
+        if not len(i):
             continue
         stage = max(stage, 1)
-        i = np.flatnonzero(inside)
-        view = robot.view
         big = predict_pixels(view, pts[i], heads[i], targets[i], size, None) >= view.min_pixels
         i = i[big]
         if not len(i):
