@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 import pytest
 from conftest import MISSIONS
 
@@ -104,3 +105,41 @@ def test_a_room_seen_too_little_is_searched_again_by_another_kind() -> None:
                                                                        ("uav1", "uav")]
         assert room["searches"][1]["coverage"] >= 0.9
     assert sorted(result.rooms_searched) == ["A.1.1.1", "A.1.1.2", "A.1.1.3"]
+
+
+@pytest.mark.parametrize("method", ["graph", "map"])
+def test_a_uav_flies_over_a_cabinet_under_its_pattern(method: str) -> None:
+    """A 2 m cabinet stands under a corner of the UAV's spiral: the UAV climbs over it rather
+    than leave that corner out, in either planning method (the kinematic default and the
+    physics one), and sees as much of the room as with the room empty."""
+    from astralis_des.world.clutter import Clutter, Placed
+
+    base = load_mission(MISSIONS / "fig7.yaml")
+
+    def search(cabinet: bool) -> tuple[Any, np.ndarray, Placed]:
+        sim = Simulation(base.with_changes(
+            team=[{"id": "uav1", "kind": "uav", "start": [70.0, 78.25, 0.0]}],
+            planning={"method": method}, scene={"clutter": False}, time_limit=400,
+            target={"room": "A.3.2.3"},
+            assignment={**base.spec.assignment.model_dump(), "start_at": 390.0}))
+        hi = sim.world.rooms[ROOM].box.hi  # the outer ring's far corner, 1 m off both walls
+        item = Placed("cabinet", ROOM, (hi[0] - 1.0, hi[1] - 1.0, 1.0), (1.2, 0.5, 2.0), 0.0)
+        if cabinet:
+            sim.scene.set_clutter(ROOM, Clutter((item,)))
+        sim.start()
+        done = sim.enqueue("uav1", "spiral_inward", ROOM)
+        sim.advance(380.0)
+        assert done.triggered and done.value.ok, done.value.message
+        trail = np.array(sim.robots["uav1"].trail_p)
+        sim.finish()
+        return done.value, trail, item
+
+    empty, _, _ = search(False)
+    result, trail, cabinet = search(True)
+    assert "out of reach" not in result.message
+    assert result.coverage == pytest.approx(empty.coverage, abs=0.03)
+    lo = np.subtract(cabinet.center, np.divide(cabinet.size, 2))
+    hi = np.add(cabinet.center, np.divide(cabinet.size, 2))
+    over = np.all((trail[:, :2] >= lo[:2]) & (trail[:, :2] <= hi[:2]), axis=1)
+    assert over.any()  # it flew over the cabinet ...
+    assert trail[over, 2].min() >= hi[2] + 0.3  # ... clear of its top by its body's radius

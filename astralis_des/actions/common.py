@@ -11,7 +11,7 @@ import simpy
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kernel.tasks import ActionResult, Task, TaskStatus
 from astralis_des.kinds import KIND_DEFAULTS, TARGET_HEIGHT
-from astralis_des.planning.navigator import Navigator, Route
+from astralis_des.planning.navigator import Navigator, Route, level_legs
 from astralis_des.sensing import GeometricSensor, Sighting
 from astralis_des.world.geometry import FloatArray
 from astralis_des.world.model import Room, World
@@ -75,8 +75,9 @@ def at_height(robot: Robot, floor_points: FloatArray) -> FloatArray:
 def route(ctx: Context, robot: Robot,
           goal_floor: FloatArray | tuple[float, ...]) -> Route:
     """Route from where the robot is to a floor-level goal, at the robot's sensor height."""
-    here = ctx.world.on_floor(robot.position(ctx.env.now))
-    return ctx.navigator.route(robot, here, np.asarray(goal_floor, dtype=float))
+    now = robot.position(ctx.env.now)
+    return ctx.navigator.route(robot, ctx.world.on_floor(now), np.asarray(goal_floor, dtype=float),
+                               at=now if robot.kind == "uav" else None)
 
 
 def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> StepGen:
@@ -121,18 +122,20 @@ def search_path(ctx: Context, robot: Robot, room: Room, plan: FloatArray, label:
     """Go to the start of a coverage path ``plan`` (floor level) and follow it, sensing."""
     ctx.sensor.scene.clutter(room.id)  # the room is furnished before the robot goes in
     pattern = at_height(robot, plan)
-    sweep = ctx.navigator.usable(robot, pattern)  # where the body fits among the furniture
+    fitting = ctx.navigator.usable(robot, pattern)  # where the body fits among the furniture
+    assert fitting.points is not None
+    sweep, skipped = fitting.points, fitting.skipped
     if len(sweep) == 0:
         return (yield from _from_the_door(ctx, robot, room, label))
     for entry in range(len(sweep)):  # the first point it can get to starts the pattern
-        approach = route(ctx, robot, sweep[entry] - np.array([0.0, 0.0, robot.height]))
+        approach = route(ctx, robot, ctx.world.on_floor(sweep[entry]))
         if approach.points is not None:
             break
     if approach.points is None:
         return failed(approach.reason)
-    sweep = sweep[entry:]
+    skipped += entry
+    sweep = level_legs(np.vstack([approach.points[-1:], sweep[entry:]]))[1:]
     distance = yield from traverse(ctx, robot, approach.points, sense=False)
-    skipped = len(pattern) - len(sweep)
     if ctx.navigator.method == "map":  # unreachable points are left out, not the search
         refined = ctx.navigator.refine(robot, sweep, skip=True)
         assert refined.points is not None
@@ -148,7 +151,7 @@ def _from_the_door(ctx: Context, robot: Robot, room: Room, label: str) -> Action
     """A pattern with no point the body fits at (a crammed room): look around from just
     inside the door instead, and say so."""
     inside = at_height(robot, np.array([room.door_point("room", DOOR_OFFSET)]))
-    if not len(ctx.navigator.usable(robot, inside)):
+    if not len(ctx.navigator.usable(robot, inside).points):  # type: ignore[arg-type]
         return failed(f"{label}: no point of the pattern is free in {room.id}, nor the door")
     way = route(ctx, robot, inside[0] - np.array([0.0, 0.0, robot.height]))
     if way.points is None:

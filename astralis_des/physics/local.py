@@ -14,8 +14,9 @@ an avatar in the next room is no reason to move. The rules, as people keep to in
   body is in it, or while a robot of higher priority is about to cross it; a robot waiting
   for another that comes its way steps off that one's route, where there is room;
 - step aside: something standing still in the lane is passed on the side with room;
-- a UAV on a walker's (a person's, an avatar's) collision course climbs over it (holding
-  while it climbs, if the walker moves) and comes back down once it is past;
+- a UAV on a walker's (a person's, an avatar's) collision course, or with one standing on its
+  route, climbs over it (holding while it climbs, if the walker moves) and comes back down
+  once it is past;
 - a robot standing idle in another's way (in its lane, in the doorway it waits for, on its
   goal) is asked to make way: it moves to the nearest free spot off the other's path
   (:mod:`.make_way`); a goal a body stands on counts as reached from farther.
@@ -180,7 +181,7 @@ class LocalLayer:
                 self.requests.setdefault(other.name, (rid, driver.path_ahead(MAKE_WAY_PATH)))
         in_doorway = self._by_doorway(me.xy, me.base_z[0])
         open_space = door is None and not in_doorway
-        climb, wait = self._climb(me, others, direction) if me.kind == "uav" and \
+        climb, wait = self._climb(me, others, direction, route) if me.kind == "uav" and \
             open_space else (0.0, False)  # not under a door's lintel, nor about to be
         hold = hold or wait
         if shift.any() and open_space:
@@ -340,16 +341,21 @@ class LocalLayer:
                 return other
         return None
 
-    def _climb(self, me: Body, others: list[Body], velocity: FloatArray) -> tuple[float, bool]:
+    def _climb(self, me: Body, others: list[Body], velocity: FloatArray,
+               route: FloatArray) -> tuple[float, bool]:
         """How far a UAV going at ``velocity`` climbs (where it is) to pass over a walker
-        on a collision course with it, and whether it waits while it climbs (for a walker
-        that moves; once up there, it flies on over it)."""
+        on a collision course with it, or standing on its ``route`` within ``CLIMB_SOON``,
+        and whether it waits while it climbs (for a walker that moves; once up there, it
+        flies on over it)."""
         need, wait = 0.0, False
+        soon = CLIMB_SOON * float(np.linalg.norm(velocity))
         for other in others:
             if other.kind not in WALKERS or other.z[1] < me.base_z[0]:
                 continue
+            clear = me.radius + other.radius + 0.3
             miss = _closest_approach(other.xy - me.xy, other.velocity - velocity, CLIMB_SOON)
-            if miss < me.radius + other.radius + 0.3:
+            reach, off_route = _on_route(route, other.xy, other.velocity)
+            if miss < clear or (off_route < clear and reach < soon):
                 need = max(need, other.z[1] + CLIMB_MARGIN - me.base_z[0])
                 wait = wait or float(np.linalg.norm(other.velocity)) > 0.05
         need = min(need, MAX_CLIMB)

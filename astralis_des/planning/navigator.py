@@ -33,6 +33,7 @@ WINDOW = 3.0  # m around a leg that its planner may use
 RIM = 0.25  # m between the points a rectangular footprint is checked at, along its edges
 NUDGE = 0.6  # m: how far a leg's end in collision may be moved to a free point
 CELL = 0.1  # m, walkers' floor grid
+LIFT_SLACK = 0.05  # m above the clearance a UAV's point lifted over furniture is put
 
 
 @dataclass(frozen=True)
@@ -56,8 +57,11 @@ class Navigator:
         self._map: VoxelMap | None = None
 
     # -- the way ---------------------------------------------------------------------------
-    def route(self, robot: Robot, start: FloatArray, goal: FloatArray) -> Route:
-        """From ``start`` to ``goal`` (both at floor level) for this robot."""
+    def route(self, robot: Robot, start: FloatArray, goal: FloatArray,
+              at: FloatArray | None = None) -> Route:
+        """From ``start`` to ``goal`` (both at floor level) for this robot. ``at``: where the
+        robot is; if above its sensor height over ``start`` (a UAV over the furniture it
+        searched from), the route leaves from there, level, and comes down past it."""
         t0 = time.perf_counter()
         try:
             try:
@@ -76,6 +80,8 @@ class Navigator:
                 if rounded is None:
                     return Route(None, reason)
                 points = rounded
+            if at is not None and float(at[2] - points[0][2]) > LIFT_SLACK:
+                points = level_legs(np.vstack([at, points[1:]]))
             if self.method == "graph":
                 return Route(points)
             return self.refine(robot, points)
@@ -104,15 +110,45 @@ class Navigator:
             out.extend(detour[1:])
         return Route(np.array(out), skipped=skipped)
 
-    def usable(self, robot: Robot, points: FloatArray) -> FloatArray:
-        """The points of a coverage path the robot's body fits at (the others dropped). A
-        walker's and the UGV's are checked in either method, on their floor's grid (cheap), so
-        that a search reports the same coverage whichever way its robot plans; a UAV's only
-        with the map (on the graph no voxel map is built, and its legs fly straight)."""
-        if self.method == "graph" and robot.kind == "uav":
-            return points
-        ok = self.fits(robot, points)
-        return points[ok] if ok.any() else points[:0]
+    def usable(self, robot: Robot, points: FloatArray) -> Route:
+        """The points of a coverage path the robot's body fits at (the others dropped and
+        counted in ``skipped``), so
+        that a search reports the same coverage whichever way its robot plans. A walker's and
+        the UGV's are checked on their floor's grid in either method (cheap). A UAV's point
+        over furniture or a person is lifted clear of it (a pilot flies over a cabinet
+        rather than leave a corner of the room unseen) when the ceiling leaves room, else
+        dropped; the map (``map`` mode only: on the graph none is built) checks the walls.
+        :func:`level_legs` then makes its legs climb and come down clear of it."""
+        if robot.kind == "uav":
+            points, ok = self._over_furniture(robot, np.atleast_2d(points))
+            if self.method == "map":
+                ok &= self.fits(robot, points)
+        else:
+            ok = self.fits(robot, points)
+        return Route(points[ok], skipped=int((~ok).sum()))
+
+    def _over_furniture(self, robot: Robot, points: FloatArray) -> tuple[FloatArray, np.ndarray]:
+        """``points`` each raised above the still furniture and people it would touch (boxes
+        grown by the body, its margin and ``KEEP_OUT``), and where the raised point keeps
+        that clearance below its room's ceiling."""
+        pts = np.array(points, dtype=float)
+        clear = BODY_RADIUS[robot.kind] + self.cfg.margin + KEEP_OUT[robot.kind]
+        boxes = self._furniture(pts.min(axis=0) - clear, pts.max(axis=0) + clear)
+        ok = np.ones(len(pts), dtype=bool)
+        if not len(boxes):
+            return pts, ok
+        lo, hi = boxes[:, 0] - clear, boxes[:, 1] + clear
+        under = np.all((pts[:, None, :2] >= lo[None, :, :2]) &
+                       (pts[:, None, :2] <= hi[None, :, :2]), axis=2)  # (N, K)
+        for i in np.flatnonzero((under & (lo[None, :, 2] <= pts[:, None, 2]) &
+                                 (hi[None, :, 2] >= pts[:, None, 2])).any(axis=1)):
+            top = float(hi[under[i], 2].max()) + LIFT_SLACK
+            room = self.world.room_at(pts[i])
+            ceiling = (room.box.hi[2] if room is not None else
+                       self.world.floor_below(pts[i]) + robot.height + clear) - clear
+            pts[i, 2] = top
+            ok[i] = top <= ceiling
+        return pts, ok
 
     def fits(self, robot: Robot, points: FloatArray) -> np.ndarray:
         """Where (``points`` at its sensor height) the robot's body is clear, by the check its
@@ -338,3 +374,17 @@ def _facing(valid, state: FloatArray) -> FloatArray:  # type: ignore[no-untyped-
     candidates[:, 2] = state[2] + turns
     ok = valid(candidates)
     return np.asarray(candidates[int(np.argmax(ok))]) if ok.any() else state
+
+
+def level_legs(points: FloatArray) -> FloatArray:
+    """``points`` with a corner put into each leg that changes height: it climbs where it
+    is, then flies level; it flies level, then comes down where it goes (so that a leg to or
+    from a point lifted over furniture does not cut the furniture's corner)."""
+    out = [points[0]]
+    for b in points[1:]:
+        a = out[-1]
+        if abs(float(b[2] - a[2])) > 1e-6:
+            out.append(np.array([a[0], a[1], b[2]]) if b[2] > a[2] else
+                       np.array([b[0], b[1], a[2]]))
+        out.append(b)
+    return np.array(out)
