@@ -59,6 +59,7 @@ CLIMB_MARGIN = 0.3  # m a climbing UAV keeps above a walker's head
 MAX_CLIMB = 0.8  # m: a UAV climbs at most this far above its course
 CLIMB_SOON = 3.0  # s: a walker this close to meeting a UAV makes it climb
 WALKERS = ("human", "avatar")
+MOVER_AHEAD = np.linspace(0.0, 3.0, 16)  # s ahead at which a mover's path is looked at
 SHARES = (1.0, 2 / 3, 1 / 3)  # of a keep-right shift, tried in turn
 MAKE_WAY_PATH = 6.0  # m of the asking robot's path that a robot making way keeps off
 
@@ -139,6 +140,9 @@ class LocalLayer:
         paths = {rid: self.cosim.drivers[rid].path_ahead(PATH_AHEAD) for rid in self.cosim.active}
         doors = _Doors(self, by_name, paths)
         self._paths = {rid: path[:, :2] + by_name[rid].offset for rid, path in paths.items()}
+        for i in self.near:  # where the movers near a robot will walk: scripted, so known
+            mover = self.cosim.movers[i][0]
+            self._paths[mover.id] = mover.positions_at(t + MOVER_AHEAD)[:, :2]
         for rid in self.cosim.active:
             self._decide_for(rid, by_name[rid], bodies, where, paths[rid], doors)
 
@@ -181,15 +185,15 @@ class LocalLayer:
                 self.requests.setdefault(other.name, (rid, driver.path_ahead(MAKE_WAY_PATH)))
         in_doorway = self._by_doorway(me.xy, me.base_z[0])
         open_space = door is None and not in_doorway
-        climb, wait = self._climb(me, others, direction, route) if me.kind == "uav" and \
-            open_space else (0.0, False)  # not under a door's lintel, nor about to be
-        hold = hold or wait
+        climb, coming = self._climb(me, others, direction, route, open_space) \
+            if me.kind == "uav" else (0.0, [])
+        hold = hold or bool(coming)
         if shift.any() and open_space:
             shift = self._clear_shift(ahead, shift, (1.0,) if aside else SHARES)
         else:
             shift = np.zeros(2)
-        if hold:  # waiting for a robot that comes this way: out of its way too
-            shift = self._yield(me, blockers, ahead, shift)
+        if hold:  # waiting for a robot or a walker that comes this way: out of its way too
+            shift = self._yield(me, [*blockers, *coming], ahead, shift)
         self.holds += hold
         self.shifts += bool(shift.any())
         self.climbs += bool(climb)
@@ -342,29 +346,38 @@ class LocalLayer:
         return None
 
     def _climb(self, me: Body, others: list[Body], velocity: FloatArray,
-               route: FloatArray) -> tuple[float, bool]:
-        """How far a UAV going at ``velocity`` climbs (where it is) to pass over a walker
-        on a collision course with it, or standing on its ``route`` within ``CLIMB_SOON``,
-        and whether it waits while it climbs (for a walker that moves; once up there, it
-        flies on over it)."""
-        need, wait = 0.0, False
-        soon = CLIMB_SOON * float(np.linalg.norm(velocity))
+               route: FloatArray, free: bool) -> tuple[float, list[Body]]:
+        """How far a UAV going at ``velocity`` climbs (where it is, if ``free``: not under a
+        door's lintel, nor about to be) to pass over a walker on a collision course with
+        it, or standing on its ``route`` within ``CLIMB_SOON``; and the walkers that move
+        it waits for (while it climbs; where it cannot, until they have passed; once up
+        there, it flies on over them)."""
+        need, moving = 0.0, []
+        speed = float(np.linalg.norm(velocity))
+        # where it will be at each of MOVER_AHEAD, going on along its route
+        mine = route[np.minimum(np.round(speed * MOVER_AHEAD / SAMPLE).astype(int),
+                                len(route) - 1)]
         for other in others:
             if other.kind not in WALKERS or other.z[1] < me.base_z[0]:
                 continue
             clear = me.radius + other.radius + 0.3
-            miss = _closest_approach(other.xy - me.xy, other.velocity - velocity, CLIMB_SOON)
+            path = self._paths.get(other.name) if other.kind == "avatar" else None
+            miss = float(np.linalg.norm(path - mine, axis=1).min()) if path is not None else \
+                _closest_approach(other.xy - me.xy, other.velocity - velocity, CLIMB_SOON)
             reach, off_route = _on_route(route, other.xy, other.velocity)
-            if miss < clear or (off_route < clear and reach < soon):
+            if miss < clear or (off_route < clear and reach < speed * CLIMB_SOON):
                 need = max(need, other.z[1] + CLIMB_MARGIN - me.base_z[0])
-                wait = wait or float(np.linalg.norm(other.velocity)) > 0.05
+                if float(np.linalg.norm(other.velocity)) > 0.05:
+                    moving.append(other)
         need = min(need, MAX_CLIMB)
         if need <= 0.0:
-            return 0.0, False
-        wait = wait and me.z[0] - me.base_z[0] < need - 0.05  # up there, it flies on
+            return 0.0, []
+        if me.z[0] - me.base_z[0] >= need - 0.05:  # up there, it flies on
+            moving = []
         centre = (me.base_z[0] + me.base_z[1]) / 2
         above = np.array([[*me.xy, centre + need]])
-        return (need, wait) if self.cosim.fits(me.name, above).all() else (0.0, False)
+        return (need, moving) if free and self.cosim.fits(me.name, above).all() else \
+            (0.0, moving)
 
 
 def _closest_approach(rel: FloatArray, velocity: FloatArray, horizon: float) -> float:
