@@ -90,3 +90,25 @@ def test_kinematic_and_physics_detectors_agree_on_a_grid_of_placements(
         client.call("removeBody", body)
     assert agree / total >= 0.95, f"{agree} of {total}"
     assert np.median(np.abs(np.log(ratios))) < np.log(1.25)
+
+
+def test_a_tall_patrolling_target_stands_on_its_floor_not_through_the_slab() -> None:
+    """A tall walker patrolling a second-floor room: its box stands on that floor at every
+    point of its round, and the UGV in the ground-floor corridor below, facing the room,
+    sees none of it (its box once hung 0.4 m down through the slab and was seen from below:
+    a fidelity benchmark's UGV found it there)."""
+    from conftest import MISSIONS
+
+    from astralis_des import Simulation, load_mission
+
+    sim = Simulation(load_mission(MISSIONS / "urban_search.yaml"))
+    room = sim.world.rooms["A.2.1.3"]
+    target = sim.scene.place_target(room.id, {"activity": "patrolling", "height": "tall"}, None)
+    centres = target.positions_at(np.linspace(0.0, 60.0, 61))
+    assert np.allclose(centres[:, 2] - target.size[2] / 2, room.box.lo[2])
+    eyes = np.repeat([[74.0, 78.7, 0.5]], len(centres), axis=0)
+    view = sim.robots["ugv1"].view
+    assert view is not None
+    pixels = predict_pixels(view, eyes, np.full(len(eyes), np.pi / 2), centres,
+                            np.asarray(target.size), sim.scene.line_of_sight)
+    assert pixels.max() == 0.0

@@ -118,3 +118,22 @@ def test_a_uav_and_a_walker_cross_a_doorway_head_on_without_touching(
     assert [e for e in sim.log.records if e["kind"] == "contact"
             and "uav1" in (e.get("robot"), e.get("other"))] == []
     sim.finish()
+
+
+@pytest.mark.parametrize("offset", [0.0, 1.0, 2.0, 3.0, 4.0, 5.0])
+def test_a_uav_leaving_a_room_waits_for_a_walker_passing_the_door(offset: float) -> None:
+    """The UAV flies out of room A.1.2.2 through its door into the corridor as an avatar
+    paces along the corridor past that door (at one of six timings): it waits in the room or
+    the doorway for the walker to pass, or climbs over it, and never touches it on its way
+    (one that walked into it tipped it over). Once there, it stands idle: a walker may brush
+    it then, and it does not fall (an idle UAV is held still)."""
+    sim = corridor_mission([{"id": "uav1", "kind": "uav", "start": [74.0, 74.5, 0.0]}])
+    add_walker(sim, [(78.0, CORRIDOR_Y - 0.4), (67.0, CORRIDOR_Y - 0.4)], offset=offset)
+    sim.start()
+    done = sim.enqueue("uav1", "move", params={"x": 69.0, "y": CORRIDOR_Y})
+    sim.advance(40.0)
+    assert done.triggered and done.value.ok, done.value.message
+    assert not sim.robots["uav1"].faulted
+    arrived = next(e["t"] for e in sim.log.records if e["kind"] == "task_finished")
+    assert [e for e in sim.log.records if e["kind"] == "contact" and e["t"] < arrived] == []
+    sim.finish()

@@ -202,7 +202,10 @@ class Scene:
         mover = None
         if avatar.get("activity") == "patrolling":
             height = AVATAR_HEIGHTS.get(str(avatar.get("height")), 1.72)
-            mover = self._patrol("target", room_id, position, (w, d, height),
+            # its box stands on the floor (centred at half its height, not at TARGET_HEIGHT:
+            # a tall walker's box reached down through the slab, seen from the floor below)
+            centre = (position[0], position[1], floor + height / 2)
+            mover = self._patrol("target", room_id, centre, (w, d, height),
                                  tuple(avatar.items()))
         size = mover.size if mover is not None else (w, d, 2 * TARGET_HEIGHT)
         self.target = Target(room_id, dict(avatar), position, mover,

@@ -152,11 +152,6 @@ class LocalLayer:
         self._deciding = rid
         direction = driver.heading_vector()
         speed = float(np.linalg.norm(direction))
-        if speed < 1e-6:
-            driver.avoid(False, np.zeros(2))
-            return
-        forward = direction / speed
-        right = np.array([forward[1], -forward[0]])
         near = np.linalg.norm(where - me.xy, axis=1) < PASS_RANGE + 1.0
         low, high = me.base_z[0] - 0.3, max(me.z[1], me.base_z[1]) + 0.3
         others = self._in_sight(me, [b for b, c in zip(bodies, near, strict=True)
@@ -167,6 +162,15 @@ class LocalLayer:
             driver.arrive_within = 0.2
             driver.avoid(False, np.zeros(2))
             return
+        if speed < 1e-6:  # at its point: a UAV still rises over a walker coming at it
+            here = me.xy[None, :]
+            climb = self._climb(me, others, np.zeros(2), here, here,
+                                not self._by_doorway(me.xy, me.base_z[0]))[0] \
+                if me.kind == "uav" else 0.0
+            driver.avoid(False, np.zeros(2), climb)
+            return
+        forward = direction / speed
+        right = np.array([forward[1], -forward[0]])
         route = ahead[:, :2] + me.offset
         if len(route) < 3:  # at the end of its path: the way it is headed
             route = me.xy + forward * np.arange(0.0, PATH_AHEAD, SAMPLE)[:, None]
@@ -185,8 +189,8 @@ class LocalLayer:
                 self.requests.setdefault(other.name, (rid, driver.path_ahead(MAKE_WAY_PATH)))
         in_doorway = self._by_doorway(me.xy, me.base_z[0])
         open_space = door is None and not in_doorway
-        climb, coming = self._climb(me, others, direction, route, open_space) \
-            if me.kind == "uav" else (0.0, [])
+        climb, coming = self._climb(me, others, direction, route, ahead[:, :2] + me.offset,
+                                    open_space) if me.kind == "uav" else (0.0, [])
         hold = hold or bool(coming)
         if shift.any() and open_space:
             shift = self._clear_shift(ahead, shift, (1.0,) if aside else SHARES)
@@ -345,8 +349,8 @@ class LocalLayer:
                 return other
         return None
 
-    def _climb(self, me: Body, others: list[Body], velocity: FloatArray,
-               route: FloatArray, free: bool) -> tuple[float, list[Body]]:
+    def _climb(self, me: Body, others: list[Body], velocity: FloatArray, route: FloatArray,
+               path_ahead: FloatArray, free: bool) -> tuple[float, list[Body]]:
         """How far a UAV going at ``velocity`` climbs (where it is, if ``free``: not under a
         door's lintel, nor about to be) to pass over a walker on a collision course with
         it, or standing on its ``route`` within ``CLIMB_SOON``; and the walkers that move
@@ -354,9 +358,10 @@ class LocalLayer:
         there, it flies on over them)."""
         need, moving = 0.0, []
         speed = float(np.linalg.norm(velocity))
-        # where it will be at each of MOVER_AHEAD, going on along its route
-        mine = route[np.minimum(np.round(speed * MOVER_AHEAD / SAMPLE).astype(int),
-                                len(route) - 1)]
+        # where it will be at each of MOVER_AHEAD, going on along its path (and staying at
+        # its end: it stops there)
+        mine = path_ahead[np.minimum(np.round(speed * MOVER_AHEAD / SAMPLE).astype(int),
+                                     len(path_ahead) - 1)]
         for other in others:
             if other.kind not in WALKERS or other.z[1] < me.base_z[0]:
                 continue
