@@ -15,8 +15,7 @@ an avatar in the next room is no reason to move. The rules, as people keep to in
   for another that comes its way steps off that one's route, where there is room;
 - step aside: something standing still in the lane is passed on the side with room;
 - a UAV on a walker's (a person's, an avatar's) collision course, or with one standing on its
-  route, climbs over it (holding while it climbs, if the walker moves) and comes back down
-  once it is past;
+  route, climbs over it (:mod:`.climb`);
 - a robot standing idle in another's way (in its lane, in the doorway it waits for, on its
   goal) is asked to make way: it moves to the nearest free spot off the other's path
   (:mod:`.make_way`); a goal a body stands on counts as reached from farther.
@@ -30,6 +29,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from astralis_des.physics.climb import MOVER_AHEAD, Climber
+from astralis_des.physics.courses import on_route
 from astralis_des.physics.drivers import SAMPLE
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
@@ -38,7 +39,6 @@ if TYPE_CHECKING:
     from astralis_des.physics.drivers import Driver
 
 PASS_RANGE = 5.0  # m: closer than this, head-on, both keep right
-LOOK_AHEAD = 0.8  # s: where the others will be, for the lane test
 BRAKING = 1.0  # s: the stopping range grows by this times the robot's speed
 SHIFT = 0.7  # m to the right at most
 STOP_RANGE = 0.8  # m between bodies' edges ahead: hold
@@ -55,11 +55,6 @@ DOOR_HALF_WIDTH = 0.7  # m along the wall from a doorway's centre that count as 
 DOOR_ON_PATH = 0.4  # m: a path passing this near a doorway's centre goes through it
 DOOR_BUSY = 1.0  # m: a body this near a doorway is in it; the others wait
 GOAL_TAKEN = 2.8  # m: a goal another body stands still on is reached this near
-CLIMB_MARGIN = 0.3  # m a climbing UAV keeps above a walker's head
-MAX_CLIMB = 0.8  # m: a UAV climbs at most this far above its course
-CLIMB_SOON = 3.0  # s: a walker this close to meeting a UAV makes it climb
-WALKERS = ("human", "avatar")
-MOVER_AHEAD = np.linspace(0.0, 3.0, 16)  # s ahead at which a mover's path is looked at
 SHARES = (1.0, 2 / 3, 1 / 3)  # of a keep-right shift, tried in turn
 MAKE_WAY_PATH = 6.0  # m of the asking robot's path that a robot making way keeps off
 
@@ -93,6 +88,7 @@ class LocalLayer:
         self.requests: dict[str, tuple[str, FloatArray]] = {}
         self._deciding = ""  # the robot whose moves are being decided
         self._paths: dict[str, FloatArray] = {}  # where each moving robot will be, xy
+        self.climber = Climber(cosim.fits)
         self.solids = cosim.world.solid_array
         self.doors = cosim.world.doorways
 
@@ -143,6 +139,7 @@ class LocalLayer:
         for i in self.near:  # where the movers near a robot will walk: scripted, so known
             mover = self.cosim.movers[i][0]
             self._paths[mover.id] = mover.positions_at(t + MOVER_AHEAD)[:, :2]
+        self.climber.paths = self._paths
         for rid in self.cosim.active:
             self._decide_for(rid, by_name[rid], bodies, where, paths[rid], doors)
 
@@ -164,7 +161,7 @@ class LocalLayer:
             return
         if speed < 1e-6:  # at its point: a UAV still rises over a walker coming at it
             here = me.xy[None, :]
-            climb = self._climb(me, others, np.zeros(2), here, here,
+            climb = self.climber.need(me, others, np.zeros(2), here, here,
                                 not self._by_doorway(me.xy, me.base_z[0]))[0] \
                 if me.kind == "uav" else 0.0
             driver.avoid(False, np.zeros(2), climb)
@@ -189,7 +186,7 @@ class LocalLayer:
                 self.requests.setdefault(other.name, (rid, driver.path_ahead(MAKE_WAY_PATH)))
         in_doorway = self._by_doorway(me.xy, me.base_z[0])
         open_space = door is None and not in_doorway
-        climb, coming = self._climb(me, others, direction, route, ahead[:, :2] + me.offset,
+        climb, coming = self.climber.need(me, others, direction, route, ahead[:, :2] + me.offset,
                                     open_space) if me.kind == "uav" else (0.0, [])
         hold = hold or bool(coming)
         if shift.any() and open_space:
@@ -222,7 +219,7 @@ class LocalLayer:
             lane = me.half_width + other.half_width + LANE_MARGIN
             if gap > PASS_RANGE:
                 continue
-            reach, off_route = _on_route(route, other.xy, other.velocity)
+            reach, off_route = on_route(route, other.xy, other.velocity)
             if along > 0 and off_route < lane + SHIFT:
                 if float(other.velocity @ forward) < -0.05:  # coming towards us: keep right
                     if not aside and abs(across + float(me.offset @ right)) < lane + SHIFT:
@@ -348,61 +345,6 @@ class LocalLayer:
             if float(np.linalg.norm(other.xy - goal[:2])) < me.radius + other.radius + 0.1:
                 return other
         return None
-
-    def _climb(self, me: Body, others: list[Body], velocity: FloatArray, route: FloatArray,
-               path_ahead: FloatArray, free: bool) -> tuple[float, list[Body]]:
-        """How far a UAV going at ``velocity`` climbs (where it is, if ``free``: not under a
-        door's lintel, nor about to be) to pass over a walker on a collision course with
-        it, or standing on its ``route`` within ``CLIMB_SOON``; and the walkers that move
-        it waits for (while it climbs; where it cannot, until they have passed; once up
-        there, it flies on over them)."""
-        need, moving = 0.0, []
-        speed = float(np.linalg.norm(velocity))
-        # where it will be at each of MOVER_AHEAD, going on along its path (and staying at
-        # its end: it stops there)
-        mine = path_ahead[np.minimum(np.round(speed * MOVER_AHEAD / SAMPLE).astype(int),
-                                     len(path_ahead) - 1)]
-        for other in others:
-            if other.kind not in WALKERS or other.z[1] < me.base_z[0]:
-                continue
-            clear = me.radius + other.radius + 0.3
-            path = self._paths.get(other.name) if other.kind == "avatar" else None
-            miss = float(np.linalg.norm(path - mine, axis=1).min()) if path is not None else \
-                _closest_approach(other.xy - me.xy, other.velocity - velocity, CLIMB_SOON)
-            reach, off_route = _on_route(route, other.xy, other.velocity)
-            if miss < clear or (off_route < clear and reach < speed * CLIMB_SOON):
-                need = max(need, other.z[1] + CLIMB_MARGIN - me.base_z[0])
-                if float(np.linalg.norm(other.velocity)) > 0.05:
-                    moving.append(other)
-        need = min(need, MAX_CLIMB)
-        if need <= 0.0:
-            return 0.0, []
-        if me.z[0] - me.base_z[0] >= need - 0.05:  # up there, it flies on
-            moving = []
-        centre = (me.base_z[0] + me.base_z[1]) / 2
-        above = np.array([[*me.xy, centre + need]])
-        return (need, moving) if free and self.cosim.fits(me.name, above).all() else \
-            (0.0, moving)
-
-
-def _closest_approach(rel: FloatArray, velocity: FloatArray, horizon: float) -> float:
-    """The least distance over the next ``horizon`` s of a body at ``rel`` moving at
-    ``velocity`` relative to a still observer."""
-    speed2 = float(velocity @ velocity)
-    t = 0.0 if speed2 < 1e-9 else min(max(-float(rel @ velocity) / speed2, 0.0), horizon)
-    return float(np.linalg.norm(rel + velocity * t))
-
-
-def _on_route(route: FloatArray, xy: FloatArray, velocity: FloatArray) -> tuple[float, float]:
-    """How far along ``route`` a body at ``xy`` (or where it will be in ``LOOK_AHEAD`` s)
-    comes nearest to it, and how near: ``(metres along, metres off)``."""
-    best_along, best_off = math.inf, math.inf
-    for where in (xy, xy + velocity * LOOK_AHEAD):
-        d = np.linalg.norm(route - where, axis=1)
-        i = int(np.argmin(d))
-        if d[i] < best_off:
-            best_along, best_off = i * SAMPLE, float(d[i])
-    return best_along, best_off
 
 
 def _round(path: FloatArray, xy: FloatArray, clear: float) -> FloatArray | None:
