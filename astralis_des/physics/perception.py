@@ -3,10 +3,11 @@
 - **Cameras** look ``rate`` times a second while an action searches, and once (around, for a
   camera that pans) when a robot waits in place. A look first tests whether the target's box
   lies in the camera's frustum at all, and whether it could show enough pixels if nothing hid
-  it (the shared detection model, :mod:`astralis_des.detection`; microseconds); only then is
-  a frame rendered (about 30 ms at 320 x 240), and the target is detected when at least
-  ``min_pixels`` of its segmentation show (within range, when the camera has one). The
-  estimate is the centroid of those pixels' depth points.
+  it, then if only walls and slabs did (the shared detection model,
+  :mod:`astralis_des.detection`; well under a millisecond); only then is a frame rendered
+  (about 30 ms at 320 x 240), and the target is detected when at least ``min_pixels`` of its
+  segmentation show (within range, when the camera has one). The estimate is the centroid
+  of those pixels' depth points.
   Frames are kept for the recording at ``record_rate``, rendered at half resolution.
 - **Lidars** scan at their rate while their robot moves; a UGV slows down for the nearest
   return ahead of it (the local planner's safety bubble).
@@ -46,8 +47,9 @@ SLOW_AT = 1.5  # m from the lidar: nearer than this ahead, a UGV slows down ...
 STOP_AT = 0.7  # m: ... to CREEP of its speed here
 CREEP = 0.3
 LIDAR_OFFSET = {"ugv": 0.6, "uav": 0.5}  # m: rays start outside the body
-CULL = 0.5  # no frame is rendered when the target, unhidden, would show less than this share
-# of the pixels a detection needs (the shared detection model's prediction)
+CULL = 0.5  # no frame is rendered when the target, unhidden (or hidden only by walls and
+# slabs), would show less than this share of the pixels a detection needs (the shared
+# detection model's prediction)
 
 
 @dataclass
@@ -195,9 +197,14 @@ class Perception:
                 heading = math.atan2(rotation[1, 2], rotation[0, 2])
                 inside, _ = in_frame(eyes.view, eye[None, :], np.array([heading]),
                                      centre[None, :], np.asarray(size), one, one)
-            if not len(inside) or predict_pixels(
+                # would it show enough pixels if nothing hid it, and then if only the walls
+                # and slabs did (exact boxes in both fidelities; furniture is left to the
+                # render)? A target in the next room costs no frame.
+                worth = len(inside) > 0 and all(predict_pixels(
                     eyes.view, eye[None, :], np.array([heading]), centre[None, :], size,
-                    None)[0] < CULL * eyes.view.min_pixels:
+                    sight)[0] >= CULL * eyes.view.min_pixels
+                    for sight in (None, self.cosim.world.line_of_sight))
+            if not worth:
                 continue
             with self.clock.timed("camera"):
                 frame = eyes.full.capture(now, yaw)
