@@ -143,3 +143,30 @@ def test_a_uav_flies_over_a_cabinet_under_its_pattern(method: str) -> None:
     over = np.all((trail[:, :2] >= lo[:2]) & (trail[:, :2] <= hi[:2]), axis=1)
     assert over.any()  # it flew over the cabinet ...
     assert trail[over, 2].min() >= hi[2] + 0.3  # ... clear of its top by its body's radius
+
+
+def test_a_uav_leaves_a_point_over_a_cabinet_level_then_down() -> None:
+    """A UAV that ended a search over a cabinet (its sensor 2.6 m up) routes on from where it
+    is: level until clear of the cabinet, then down, in the planner that checks furniture
+    (from its usual height over that spot it would start inside the cabinet)."""
+    from astralis_des.world.clutter import Clutter, Placed
+
+    base = load_mission(MISSIONS / "fig7.yaml")
+    sim = Simulation(base.with_changes(
+        team=[{"id": "uav1", "kind": "uav", "start": [70.0, 78.25, 0.0]}],
+        planning={"method": "map"}, scene={"clutter": False}, target={"room": "A.3.2.3"}))
+    hi = sim.world.rooms[ROOM].box.hi
+    spot = np.array([hi[0] - 1.0, hi[1] - 1.0, 0.0])
+    sim.scene.set_clutter(ROOM, Clutter((Placed("cabinet", ROOM, (spot[0], spot[1], 1.0),
+                                                (1.2, 0.5, 2.0), 0.0),)))
+    robot, nav = sim.robots["uav1"], sim.navigator
+    over = nav.usable(robot, spot[None, :] + [0.0, 0.0, robot.height]).points
+    assert over is not None and over[0, 2] >= 2.0 + 0.3 + 0.05  # lifted over the cabinet
+    goal = np.array([70.0, 78.25, 0.0])  # the corridor
+    stuck = nav.route(robot, spot, goal)
+    assert stuck.points is None and "start in collision" in stuck.reason
+    way = nav.route(robot, spot, goal, at=over[0])
+    assert way.points is not None, way.reason
+    assert np.allclose(way.points[0], over[0])
+    assert way.points[1, 2] == pytest.approx(over[0, 2])  # level first ...
+    assert np.linalg.norm(way.points[1, :2] - spot[:2]) > 0.5  # ... past the cabinet
