@@ -151,7 +151,8 @@ def _from_the_door(ctx: Context, robot: Robot, room: Room, label: str) -> Action
     """A pattern with no point the body fits at (a crammed room): look around from just
     inside the door instead, and say so."""
     inside = at_height(robot, np.array([room.door_point("room", DOOR_OFFSET)]))
-    if not len(ctx.navigator.usable(robot, inside).points):  # type: ignore[arg-type]
+    door = ctx.navigator.usable(robot, inside).points
+    if door is None or not len(door):
         return failed(f"{label}: no point of the pattern is free in {room.id}, nor the door")
     way = route(ctx, robot, inside[0] - np.array([0.0, 0.0, robot.height]))
     if way.points is None:

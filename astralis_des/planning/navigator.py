@@ -81,7 +81,9 @@ class Navigator:
                     return Route(None, reason)
                 points = rounded
             if at is not None and float(at[2] - points[0][2]) > LIFT_SLACK:
-                points = level_legs(np.vstack([at, points[1:]]))
+                # the first leg only: the others may climb a stairwell, on the graph's slant
+                first = level_legs(np.vstack([at, points[1:2]]))
+                points = np.vstack([first[:-1] if len(points) > 1 else first, points[1:]])
             if self.method == "graph":
                 return Route(points)
             return self.refine(robot, points)
@@ -112,13 +114,13 @@ class Navigator:
 
     def usable(self, robot: Robot, points: FloatArray) -> Route:
         """The points of a coverage path the robot's body fits at (the others dropped and
-        counted in ``skipped``), so
-        that a search reports the same coverage whichever way its robot plans. A walker's and
-        the UGV's are checked on their floor's grid in either method (cheap). A UAV's point
-        over furniture or a person is lifted clear of it (a pilot flies over a cabinet
-        rather than leave a corner of the room unseen) when the ceiling leaves room, else
-        dropped; the map (``map`` mode only: on the graph none is built) checks the walls.
-        :func:`level_legs` then makes its legs climb and come down clear of it."""
+        counted in ``skipped``), the same whichever way the robot plans, so that a search
+        reports the same coverage in both. A walker's and the UGV's are checked on their
+        floor's grid (cheap). A UAV's point over furniture or a person is lifted clear of it
+        (a pilot flies over a cabinet rather than leave a corner of the room unseen) when the
+        ceiling leaves room, else dropped; the map (``map`` mode only: on the graph none is
+        built) checks the walls. :func:`level_legs` then makes its legs climb and come down
+        clear of what it flies over."""
         if robot.kind == "uav":
             points, ok = self._over_furniture(robot, np.atleast_2d(points))
             if self.method == "map":
