@@ -105,8 +105,7 @@ def room_report(sim: Simulation) -> dict[str, dict[str, Any]]:
                      "action": task.action, "status": res.status.value,
                      "coverage": res.coverage}
                     for task, res in sim.finished if task.room == room and task.action != "move"]
-        seen = [float(res.coverage) for task, res in sim.finished
-                if task.room == room and task.action != "move" and res.coverage is not None]
+        seen = [float(s["coverage"]) for s in searches if s["coverage"] is not None]
         best = max(seen) if seen else None
         if room in sim.searched:
             status = "searched" if best is None or best >= threshold else "undercovered"

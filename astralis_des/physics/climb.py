@@ -25,19 +25,19 @@ MOVER_AHEAD = np.linspace(0.0, 3.0, 16)  # s ahead at which a mover's path is lo
 
 class Climber:
     """The climbs of the UAVs of one co-simulation. ``fits(robot, points)``: where its body
-    is clear; ``paths``: where the movers near a moving robot will walk (set each update)."""
+    is clear."""
 
     def __init__(self, fits: Callable[[str, FloatArray], np.ndarray]) -> None:
         self.fits = fits
-        self.paths: dict[str, FloatArray] = {}
 
     def need(self, me: Body, others: list[Body], velocity: FloatArray, route: FloatArray,
-             path_ahead: FloatArray, free: bool) -> tuple[float, list[Body]]:
+             path_ahead: FloatArray, free: bool,
+             paths: dict[str, FloatArray]) -> tuple[float, list[Body]]:
         """How far a UAV going at ``velocity`` climbs (where it is, if ``free``: not under a
         door's lintel, nor about to be) to pass over a walker on a collision course with
         it, or standing on its ``route`` within ``CLIMB_SOON``; and the walkers that move it
         waits for (while it climbs; where it cannot, until they have passed; once up there,
-        it flies on over them)."""
+        it flies on over them). ``paths``: where the movers near a moving robot will walk."""
         need, moving = 0.0, []
         speed = float(np.linalg.norm(velocity))
         # where it will be at each of MOVER_AHEAD, going on along its path (and staying at
@@ -48,7 +48,7 @@ class Climber:
             if other.kind not in WALKERS or other.z[1] < me.base_z[0]:
                 continue
             clear = me.radius + other.radius + 0.3
-            path = self.paths.get(other.name) if other.kind == "avatar" else None
+            path = paths.get(other.name) if other.kind == "avatar" else None
             miss = float(np.linalg.norm(path - mine, axis=1).min()) if path is not None else \
                 closest_approach(other.xy - me.xy, other.velocity - velocity, CLIMB_SOON)
             reach, off_route = on_route(route, other.xy, other.velocity)

@@ -11,6 +11,7 @@ from astralis_des.world.geometry import FloatArray
 
 LOOK_AHEAD = 0.8  # s: where the others will be, for the lane test
 
+
 def on_route(route: FloatArray, xy: FloatArray, velocity: FloatArray) -> tuple[float, float]:
     """How far along ``route`` a body at ``xy`` (or where it will be in ``LOOK_AHEAD`` s)
     comes nearest to it, and how near: ``(metres along, metres off)``."""

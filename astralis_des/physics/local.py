@@ -139,7 +139,6 @@ class LocalLayer:
         for i in self.near:  # where the movers near a robot will walk: scripted, so known
             mover = self.cosim.movers[i][0]
             self._paths[mover.id] = mover.positions_at(t + MOVER_AHEAD)[:, :2]
-        self.climber.paths = self._paths
         for rid in self.cosim.active:
             self._decide_for(rid, by_name[rid], bodies, where, paths[rid], doors)
 
@@ -162,8 +161,8 @@ class LocalLayer:
         if speed < 1e-6:  # at its point: a UAV still rises over a walker coming at it
             here = me.xy[None, :]
             climb = self.climber.need(me, others, np.zeros(2), here, here,
-                                not self._by_doorway(me.xy, me.base_z[0]))[0] \
-                if me.kind == "uav" else 0.0
+                                      not self._by_doorway(me.xy, me.base_z[0]),
+                                      self._paths)[0] if me.kind == "uav" else 0.0
             driver.avoid(False, np.zeros(2), climb)
             return
         forward = direction / speed
@@ -187,7 +186,8 @@ class LocalLayer:
         in_doorway = self._by_doorway(me.xy, me.base_z[0])
         open_space = door is None and not in_doorway
         climb, coming = self.climber.need(me, others, direction, route, ahead[:, :2] + me.offset,
-                                    open_space) if me.kind == "uav" else (0.0, [])
+                                          open_space, self._paths) \
+            if me.kind == "uav" else (0.0, [])
         hold = hold or bool(coming)
         if shift.any() and open_space:
             shift = self._clear_shift(ahead, shift, (1.0,) if aside else SHARES)

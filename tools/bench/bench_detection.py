@@ -60,11 +60,9 @@ def classify(sim: Any) -> str:
     """Why the target was never detected (see the module's docstring)."""
     from astralis_des.detection import predict_pixels
     from astralis_des.sensing import in_frame
-    from astralis_des.world.geometry import segments_hit_boxes
 
     stage = 0
     size = np.asarray(sim.target.size, dtype=float)
-    walls = sim.world.solid_array
     for robot in sim.robots.values():
         if robot.view is None:
             continue
@@ -83,12 +81,8 @@ def classify(sim: Any) -> str:
         if not len(i):
             continue
         stage = max(stage, 2)
-
-        def through_walls(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-            return ~segments_hit_boxes(a, b, walls)
-
         ok = predict_pixels(view, pts[i], heads[i], targets[i], size,
-                            through_walls) >= view.min_pixels
+                            sim.world.line_of_sight) >= view.min_pixels
         i = i[ok]
         if not len(i):
             continue
