@@ -30,6 +30,7 @@ if TYPE_CHECKING:
 SAMPLE_STEP = 0.25  # m between sensing samples along a path
 CELL = 0.5  # m, floor cells for coverage
 CHUNK = 16  # looks judged at a time, in time order, until one detects
+BOUND_SHARE = 0.8  # of min_pixels the unhidden bound (sampled coarser) must reach
 CORNERS = np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5])).reshape(3, -1).T
 
 
@@ -83,7 +84,7 @@ class GeometricSensor:
         if len(near) == 0:
             return None
         bound = predict_pixels(view, pts[near], headings[near], targets[near], size, None)
-        near = near[bound >= view.min_pixels]
+        near = near[bound >= BOUND_SHARE * view.min_pixels]  # coarser: a margin
         for start in range(0, len(near), CHUNK):
             idx = near[start:start + CHUNK]
             pixels = predict_pixels(view, pts[idx], headings[idx], targets[idx], size,

@@ -68,3 +68,61 @@ def test_a_sneak_peek_at_every_door_of_building_a_touches_no_wall() -> None:
     assert len(results) == 18 and all(r.ok for r in results), [r.message for r in results]
     assert [e for e in sim.log.records if e["kind"] == "contact"] == []
     sim.finish()
+
+
+def test_a_husky_arriving_at_speed_stops_before_it_turns_to_look() -> None:
+    """Driving along the corridor to room A.1.1.3's door and turning into the room (a sneak
+    peek), the Husky looks from the door point, not half a metre past it: it brakes to a
+    stop before turning on the spot (turning while still rolling at 0.6 m/s carried it
+    0.5 m on, out of line with the doorway)."""
+    from conftest import MISSIONS
+
+    from astralis_des import Simulation, load_mission
+    from astralis_des.actions.common import stand_off
+    from astralis_des.actions.ugv import SNEAK_OFFSET
+
+    base = load_mission(MISSIONS / "fig7.yaml")
+    sim = Simulation(base.with_changes(
+        fidelity="physics", team=[{"id": "ugv1", "kind": "ugv", "start": [77.0, 78.6, 0.0]}],
+        scene={"clutter": False}, time_limit=500, target={"room": "B.1.1.1"},
+        assignment={**base.spec.assignment.model_dump(), "start_at": 400.0}))
+    robot = sim.robots["ugv1"]
+    room = sim.world.rooms["A.1.1.3"]
+    door = np.asarray(room.door_point("corridor", offset=stand_off(robot, SNEAK_OFFSET)))
+    sim.start()
+    peek = sim.enqueue("ugv1", "sneak_peek", room.id)
+    sim.advance(60.0)
+    assert peek.triggered and peek.value.ok, peek.value
+    here = sim.cosim.drivers["ugv1"].position()
+    sim.finish()
+    assert np.linalg.norm(here[:2] - door[:2]) < 0.2, (here, door)
+
+
+def test_a_husky_turning_back_to_the_corridor_takes_the_kinematic_time() -> None:
+    """At room A.1.1.3's door, facing into the room (as after a look), the UGV drives 4 m west
+    along the corridor to the next door. The physics Husky takes the kinematic fidelity's
+    time within 10%: it turns on the spot only until it faces within 60 degrees of its way
+    and curves the rest (the kinematic profile turned on the spot all the way: 15% slower),
+    and while it turns back its lidar's slow-down looks the way it is headed, not at the
+    corridor's wall it turns away from (it crept at 0.2 m/s for 3 s: 30% slower)."""
+    from conftest import MISSIONS
+
+    from astralis_des import Simulation, load_mission
+
+    base = load_mission(MISSIONS / "fig7.yaml")
+    times = {}
+    for fidelity in ("kinematic", "physics"):
+        sim = Simulation(base.with_changes(
+            fidelity=fidelity, team=[{"id": "ugv1", "kind": "ugv", "start": [74.0, 77.6, 0.0]}],
+            scene={"clutter": False}, time_limit=500, target={"room": "B.1.1.1"},
+            assignment={**base.spec.assignment.model_dump(), "start_at": 400.0}))
+        sim.start()
+        north = sim.enqueue("ugv1", "move", params={"x": 74.0, "y": 78.69})
+        sim.advance(15.0)
+        assert north.triggered and north.value.ok, north.value
+        drive = sim.enqueue("ugv1", "move", params={"x": 70.0, "y": 78.69})
+        sim.advance(40.0)
+        assert drive.triggered and drive.value.ok, drive.value
+        times[fidelity] = drive.value.end - drive.value.start
+        sim.finish()
+    assert 0.9 < times["physics"] / times["kinematic"] < 1.1, times

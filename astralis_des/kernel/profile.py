@@ -16,7 +16,8 @@ import numpy as np
 from astralis_des.world.geometry import FloatArray
 
 MIN_CORNER = 0.1  # share of the cruise speed kept through a reversal
-STOP_ANGLE = math.radians(10)  # a non-holonomic robot stops to turn beyond this
+STOP_ANGLE = math.radians(60)  # a non-holonomic robot turns on the spot beyond this (the rest
+# it takes curving: the physics Husky's pure pursuit spins while its aim is more than this off)
 MIN_TURN_LEG = 0.25  # m: a shorter leg is a nudge, not worth turning on the spot for
 
 
@@ -83,7 +84,7 @@ def build(points: FloatArray, speed: float, accel: float | None = None,
             if flat[i] and lengths[i] >= MIN_TURN_LEG:
                 turns[i] = abs(math.remainder(headings[i] - previous, math.tau))
                 previous = headings[i]
-        turns[turns < STOP_ANGLE] = 0.0
+        turns = np.where(turns > STOP_ANGLE, turns - STOP_ANGLE, 0.0)
     # speed allowed at each vertex: 0 at the ends, at turns on the spot, reduced at corners
     v = np.full(n + 1, speed)
     if accel is not None:

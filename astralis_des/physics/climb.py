@@ -31,21 +31,24 @@ class Climber:
         self.fits = fits
 
     def need(self, me: Body, others: list[Body], velocity: FloatArray, route: FloatArray,
-             path_ahead: FloatArray, free: bool,
-             paths: dict[str, FloatArray]) -> tuple[float, list[Body]]:
+             path_ahead: FloatArray, free: bool, paths: dict[str, FloatArray],
+             lowest: float | None = None) -> tuple[float, list[Body]]:
         """How far a UAV going at ``velocity`` climbs (where it is, if ``free``: not under a
         door's lintel, nor about to be) to pass over a walker on a collision course with
         it, or standing on its ``route`` within ``CLIMB_SOON``; and the walkers that move it
         waits for (while it climbs; where it cannot, until they have passed; once up there,
-        it flies on over them). ``paths``: where the movers near a moving robot will walk."""
+        it flies on over them). ``paths``: where the movers near a moving robot will walk;
+        ``lowest``: the bottom of its band where its course comes lowest ahead (a walker
+        under the band now but over that counts: the UAV is coming down)."""
         need, moving = 0.0, []
         speed = float(np.linalg.norm(velocity))
         # where it will be at each of MOVER_AHEAD, going on along its path (and staying at
         # its end: it stops there)
         mine = path_ahead[np.minimum(np.round(speed * MOVER_AHEAD / SAMPLE).astype(int),
                                      len(path_ahead) - 1)]
+        floor = me.base_z[0] if lowest is None else min(me.base_z[0], lowest)
         for other in others:
-            if other.kind not in WALKERS or other.z[1] < me.base_z[0]:
+            if other.kind not in WALKERS or other.z[1] < floor:
                 continue
             clear = me.radius + other.radius + 0.3
             path = paths.get(other.name) if other.kind == "avatar" else None

@@ -56,6 +56,7 @@ DOOR_ON_PATH = 0.4  # m: a path passing this near a doorway's centre goes throug
 DOOR_BUSY = 1.0  # m: a body this near a doorway is in it; the others wait
 GOAL_TAKEN = 2.8  # m: a goal another body stands still on is reached this near
 SHARES = (1.0, 2 / 3, 1 / 3)  # of a keep-right shift, tried in turn
+ROUND_MARGIN = 0.05  # m beyond the lane a robot stepping round a standing body keeps
 MAKE_WAY_PATH = 6.0  # m of the asking robot's path that a robot making way keeps off
 
 
@@ -186,7 +187,7 @@ class LocalLayer:
         in_doorway = self._by_doorway(me.xy, me.base_z[0])
         open_space = door is None and not in_doorway
         climb, coming = self.climber.need(me, others, direction, route, ahead[:, :2] + me.offset,
-                                          open_space, self._paths) \
+                                          open_space, self._paths, _lowest(me, ahead)) \
             if me.kind == "uav" else (0.0, [])
         hold = hold or bool(coming)
         if shift.any() and open_space:
@@ -347,6 +348,14 @@ class LocalLayer:
         return None
 
 
+def _lowest(me: Body, ahead: FloatArray) -> float:
+    """The bottom of a UAV's band as low as its course comes over its path ahead: coming down
+    from a lifted point (over furniture, or where it made way), it must not come down onto a
+    walker."""
+    low = float(ahead[:, 2].min()) + HEIGHTS["uav"][0] if len(ahead) else me.base_z[0]
+    return min(me.base_z[0], low)
+
+
 def _round(path: FloatArray, xy: FloatArray, clear: float) -> FloatArray | None:
     """The shift off ``path`` (a vector) that passes a body standing at ``xy`` ``clear`` away
     on the side away from it, measured where the path comes nearest to it; None when the
@@ -362,6 +371,7 @@ def _round(path: FloatArray, xy: FloatArray, clear: float) -> FloatArray | None:
         return None
     normal = np.array([tangent[1], -tangent[0]]) / norm
     offset = float((xy - path[i]) @ normal)  # where it stands, across the path
+    clear += ROUND_MARGIN  # past the lane's edge, not on it (where the hold test wavers)
     side = offset - clear if offset >= 0 else offset + clear
     return normal * side
 

@@ -253,7 +253,12 @@ class Perception:
         while not done.triggered:
             with self.clock.timed("lidar"):
                 scan = lidar.scan(self.env.now)
-                ahead = np.abs(scan.angles) <= AHEAD
+                # the sector it slows down for looks the way it is headed (to its pursued
+                # point), not at a wall it is turning away from
+                way = driver.heading_vector()
+                off = math.atan2(way[1], way[0]) - lidar.heading() if way.any() else 0.0
+                ahead = np.abs(np.remainder(scan.angles - off + math.pi, math.tau) - math.pi) \
+                    <= AHEAD
                 nearest = float(scan.ranges[ahead].min()) if ahead.any() else math.inf
             share = min(max((nearest - STOP_AT) / (SLOW_AT - STOP_AT), CREEP), 1.0)
             driver.slow_down(share)

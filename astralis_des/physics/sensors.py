@@ -220,11 +220,15 @@ class Lidar2D:
                         "within its bounding box (%.2f m)", self.body, self.start_offset,
                         math.hypot(reach[0], reach[1]))
 
+    def heading(self) -> float:
+        """The body's heading (radians, counter-clockwise from x): the beams' zero."""
+        _, rotation = _body_pose(self.client, self.body)
+        return math.atan2(rotation[1, 0], rotation[0, 0])
+
     def _frame(self) -> tuple[FloatArray, FloatArray]:
         """Sensor centre and world directions of the beams."""
         position, rotation = _body_pose(self.client, self.body)
-        heading = math.atan2(rotation[1, 0], rotation[0, 0])
-        a = self.angles + heading
+        a = self.angles + math.atan2(rotation[1, 0], rotation[0, 0])
         directions = np.column_stack([np.cos(a), np.sin(a), np.zeros_like(a)])
         return position + rotation @ self.mount, directions
 

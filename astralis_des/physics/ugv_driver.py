@@ -27,6 +27,7 @@ from astralis_des.world.geometry import FloatArray
 
 UGV_RATE = 40  # Hz: pure pursuit updates (when the control rate is a multiple of it)
 FACING = 0.08  # rad: close enough to the heading asked for
+STOPPED = 0.05  # m/s: slower than this it has stopped (and may turn on the spot)
 LIFT_RISE = 0.3  # m: a leg climbing more than this is ridden on the stairwell's lift
 CALL_RANGE = 2.5  # m from the lift's column: reserve it, and call it to this floor
 WAIT_AT = 0.8  # m from the column: wait here while the platform is not at this floor
@@ -199,6 +200,11 @@ class UgvDriver(Avoiding):
         return None
 
     def _turn(self) -> str | None:
+        """Brake to a stop, then turn on the spot (turning while it still rolls would carry
+        it on, skidding, half a metre past where it was asked to look from)."""
+        if abs(self.husky.velocity_in_body()[0]) > STOPPED:
+            self.husky.drive(0.0, 0.0)
+            return None
         error = math.remainder(self.heading - self.husky.pose()[3], math.tau)
         if abs(error) < FACING:
             self.husky.drive(0.0, 0.0)
