@@ -9,19 +9,20 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.1.0"
+from astralis_des.version import __version__
+
 __all__ = ["InputError", "Mission", "RunResult", "Simulation", "__version__", "load_mission"]
 
 if TYPE_CHECKING:
     from astralis_des.errors import InputError
-    from astralis_des.kernel.result import RunResult
-    from astralis_des.kernel.simulation import Simulation
     from astralis_des.mission.loader import Mission, load_mission
+    from astralis_des.simulation import Simulation
+    from astralis_des.simulation.result import RunResult
 
 _LAZY = {
     "InputError": "astralis_des.errors",
-    "RunResult": "astralis_des.kernel.result",
-    "Simulation": "astralis_des.kernel.simulation",
+    "RunResult": "astralis_des.simulation.result",
+    "Simulation": "astralis_des.simulation.core",
     "Mission": "astralis_des.mission.loader",
     "load_mission": "astralis_des.mission.loader",
 }

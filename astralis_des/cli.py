@@ -12,11 +12,11 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-if TYPE_CHECKING:
-    from astralis_des.kernel.result import RunResult
+from astralis_des.exits import EXIT_BAD_INPUT, EXIT_INTERRUPTED
 
-EXIT_BAD_INPUT = 2
-EXIT_INTERRUPTED = 130
+if TYPE_CHECKING:
+    from astralis_des.simulation.result import RunResult
+
 Command = Callable[[argparse.Namespace], int]
 COMMANDS: dict[str, Command] = {}
 
@@ -103,7 +103,7 @@ def _positive(text: str) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     if args.version:
-        from astralis_des import __version__
+        from astralis_des.version import __version__
 
         print(f"astralis-des {__version__}")
         return 0
@@ -221,7 +221,7 @@ def _world_import(args: argparse.Namespace) -> int:
 
 @world_command("show")
 def _world_show(args: argparse.Namespace) -> int:
-    from astralis_des.world.show import show_world
+    from astralis_des.sinks.world_show import show_world
 
     out = args.output or str(Path("out") / f"world_{Path(args.world).stem}.rrd")
     shown = show_world(args.world, args.messiness, out, seed=args.seed,
@@ -258,7 +258,8 @@ def _schema(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     from rich.console import Console
 
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.mission.overrides import mission_from_args
+    from astralis_des.simulation import Simulation
 
     mission, out = mission_from_args(args)
     console = Console(stderr=True, quiet=args.quiet)
@@ -273,28 +274,6 @@ def _run(args: argparse.Namespace) -> int:
     if not args.quiet:
         _print_summary(Console(), result, out)
     return 0
-
-
-def mission_from_args(args: argparse.Namespace) -> tuple[Any, Path]:
-    """The mission file with the command line's overrides, and its output folder."""
-    from astralis_des.errors import InputError
-    from astralis_des.mission.loader import load_mission
-
-    mission = load_mission(args.mission)
-    if args.seed is not None:
-        mission = mission.with_changes(seed=args.seed)
-    if args.fidelity is not None:
-        mission = mission.with_changes(fidelity=args.fidelity)
-    if args.no_recording:
-        outputs = mission.spec.outputs.model_copy(update={"recording": False})
-        mission = mission.with_changes(outputs=outputs.model_dump())
-    if getattr(args, "manual", False):  # serve and chat
-        assignment = mission.spec.assignment.model_copy(update={"auto": False})
-        mission = mission.with_changes(assignment=assignment.model_dump())
-    out = Path(args.out or mission.spec.outputs.dir or Path("out") / mission.name)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"{out} exists and is not a folder", key="--out")
-    return mission, out
 
 
 def _with_progress(console: Any, limit: float, run: Callable[[Any], RunResult]) -> RunResult:

@@ -19,9 +19,12 @@ shows about half its pixels, one at the frame's edge the part inside it.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
+from astralis_des.kinds import TARGET_SIZE
 from astralis_des.view import View
 from astralis_des.world.geometry import FloatArray
 
@@ -30,6 +33,19 @@ SAMPLES = 5  # per side of each face, where something may hide part of the targe
 COARSE = 3  # per side, for the unhidden bound (an area sum: accurate at 3 already)
 NEAR = 0.05  # m: the renderer's near plane
 Sight = Callable[[FloatArray, FloatArray], np.ndarray]  # (eyes, points) -> clear
+
+
+@dataclass(frozen=True)
+class Sighting:
+    """A detection: when (seconds after the motion's start), from where, of what, how well."""
+
+    t: float  # seconds after the motion's start
+    robot_position: tuple[float, float, float]
+    target_position: tuple[float, float, float]
+    distance: float
+    estimate: tuple[float, float, float]  # where the sensor put the target
+    error: float  # m between the estimate and the target
+    pixels: int | None = None  # target pixels in the frame (physics)
 
 
 def _face_grid(n: int) -> FloatArray:
@@ -103,3 +119,30 @@ def predict_pixels(view: View, eyes: FloatArray, headings: FloatArray, centres: 
                                  float(view.pixels[0] * view.pixels[1]))
     return out
 
+
+def swath(view: View, drop: float) -> float:
+    """Width across the direction of travel within which a target whose centre is ``drop``
+    metres below the camera shows enough pixels to be detected at some point of a straight
+    pass (to 1 cm): moving ahead, the camera searches a strip this wide."""
+    return _swath(view, round(drop, 3))
+
+
+@lru_cache(maxsize=64)
+def _swath(view: View, drop: float) -> float:
+    reach = min(view.reach, 4.0 * max(drop, 0.5))
+    xs = np.arange(-reach, reach + 1e-9, 0.05)  # along the track
+
+    def widest(ys: FloatArray) -> float | None:
+        """The largest offset across the track in ``ys`` at which the target is detected."""
+        gx, gy = np.meshgrid(xs, ys, indexing="ij")
+        centres = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, -drop)])
+        pixels = predict_pixels(view, np.zeros((len(centres), 3)), np.zeros(len(centres)),
+                                centres, np.asarray(TARGET_SIZE), None).reshape(gx.shape)
+        seen = (pixels >= view.min_pixels).any(axis=0)
+        return float(ys[seen].max()) if seen.any() else None
+
+    coarse = widest(np.arange(0.0, reach + 1e-9, 0.1))
+    if coarse is None:
+        return 0.0
+    fine = widest(np.arange(coarse, coarse + 0.1, 0.01))
+    return round(2 * (fine if fine is not None else coarse), 2)

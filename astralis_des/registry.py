@@ -1,7 +1,14 @@
-"""One registry idiom for actions, strategies, co-simulations and timeline events."""
+"""One registry idiom for actions, strategies, co-simulations, sinks and timeline events.
+
+A registry may name its ``plugins``: modules imported (by name, with :mod:`importlib`) the
+first time it is looked into, whose import registers the entries. So a lower layer can hold a
+registry whose entries live in a higher one (the mission layer checks action names; the
+actions, which need the kernel, register them), and nothing imports upward.
+"""
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Hashable, Iterator
 from typing import Generic, TypeVar
 
@@ -18,9 +25,15 @@ class UnknownEntry(LookupError):
 class Registry(Generic[K, V]):
     """Entries registered by decorator; a duplicate key is a bug and is refused."""
 
-    def __init__(self, what: str) -> None:
+    def __init__(self, what: str, plugins: tuple[str, ...] = ()) -> None:
         self.what = what
         self._entries: dict[K, V] = {}
+        self._plugins = plugins  # modules to import before the first look-up
+
+    def _load(self) -> None:
+        plugins, self._plugins = self._plugins, ()
+        for module in plugins:
+            importlib.import_module(module)
 
     def register(self, key: K) -> Callable[[V], V]:
         def add(entry: V) -> V:
@@ -31,7 +44,13 @@ class Registry(Generic[K, V]):
 
         return add
 
+    def remove(self, key: K) -> V:
+        """Take an entry out again (a plug-in tried in a test or a notebook)."""
+        return self._entries.pop(key)
+
     def get(self, key: K) -> V:
+        if self._plugins:
+            self._load()
         try:
             return self._entries[key]
         except KeyError:
@@ -41,9 +60,13 @@ class Registry(Generic[K, V]):
             ) from None
 
     def __contains__(self, key: object) -> bool:
+        if self._plugins:
+            self._load()
         return key in self._entries
 
     def __iter__(self) -> Iterator[K]:
+        if self._plugins:
+            self._load()
         return iter(sorted(self._entries, key=self._name))
 
     @staticmethod

@@ -12,12 +12,11 @@ floor cells where a target would show ``min_pixels`` with its centre in sight).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from astralis_des.detection import predict_pixels
+from astralis_des.detection import Sighting, predict_pixels
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kinds import TARGET_HEIGHT
 from astralis_des.view import View, look_headings, travel_headings
@@ -25,24 +24,14 @@ from astralis_des.world.geometry import FloatArray, resample
 from astralis_des.world.model import Room
 
 if TYPE_CHECKING:
-    from astralis_des.kernel.scene import Scene, Target
+    from astralis_des.world.scene import Scene, Target
 
 SAMPLE_STEP = 0.25  # m between sensing samples along a path
 CELL = 0.5  # m, floor cells for coverage
 CHUNK = 16  # looks judged at a time, in time order, until one detects
 BOUND_SHARE = 0.8  # of min_pixels the unhidden bound (sampled coarser) must reach
+__all__ = ["GeometricSensor", "Sighting", "in_frame"]
 CORNERS = np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5])).reshape(3, -1).T
-
-
-@dataclass(frozen=True)
-class Sighting:
-    t: float  # seconds after the motion's start
-    robot_position: tuple[float, float, float]
-    target_position: tuple[float, float, float]
-    distance: float
-    estimate: tuple[float, float, float]  # where the sensor put the target
-    error: float  # m between the estimate and the target
-    pixels: int | None = None  # target pixels in the frame (physics)
 
 
 class GeometricSensor:

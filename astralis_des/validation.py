@@ -125,3 +125,18 @@ def _model_at(model: type[BaseModel], path: KeyPath) -> type[BaseModel] | None:
         current = _step(current, part)
     models = _models_in(current)
     return models[0] if models else None
+
+
+def check_unique_ids(doc: LocatedYaml, key: str) -> None:
+    """Point at the second use of an id in the list ``key``, with the line of the first."""
+    items = doc.data.get(key) if isinstance(doc.data, dict) else None
+    seen: dict[object, int] = {}
+    for i, item in enumerate(items if isinstance(items, list) else []):
+        ident = item.get("id") if isinstance(item, dict) else None
+        if ident is None or not isinstance(ident, str | int):
+            continue
+        if ident in seen:
+            first = doc.line_of((key, seen[ident], "id"))
+            raise doc.error((key, i, "id"), f"id '{ident}' is used twice"
+                            + (f" (first at line {first})" if first else ""))
+        seen[ident] = i

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property, lru_cache
+from functools import cached_property
 
 import numpy as np
 
@@ -90,36 +90,6 @@ class View:
         from astralis_des.kinds import TARGET_FACE
 
         return float(self.focal * math.sqrt(TARGET_FACE / self.min_pixels))
-
-    def swath(self, drop: float) -> float:
-        """Width across the direction of travel within which a target whose centre is
-        ``drop`` metres below the camera shows enough pixels to be detected at some point of
-        a straight pass (to 1 cm): moving ahead, the camera searches a strip this wide."""
-        return _swath(self, round(drop, 3))
-
-
-@lru_cache(maxsize=64)
-def _swath(view: View, drop: float) -> float:
-    from astralis_des.detection import predict_pixels
-    from astralis_des.kinds import TARGET_SIZE
-
-    reach = min(view.reach, 4.0 * max(drop, 0.5))
-    xs = np.arange(-reach, reach + 1e-9, 0.05)  # along the track
-
-    def widest(ys: FloatArray) -> float | None:
-        """The largest offset across the track in ``ys`` at which the target is detected."""
-        gx, gy = np.meshgrid(xs, ys, indexing="ij")
-        centres = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, -drop)])
-        pixels = predict_pixels(view, np.zeros((len(centres), 3)), np.zeros(len(centres)),
-                                centres, np.asarray(TARGET_SIZE), None).reshape(gx.shape)
-        seen = (pixels >= view.min_pixels).any(axis=0)
-        return float(ys[seen].max()) if seen.any() else None
-
-    coarse = widest(np.arange(0.0, reach + 1e-9, 0.1))
-    if coarse is None:
-        return 0.0
-    fine = widest(np.arange(coarse, coarse + 0.1, 0.01))
-    return round(2 * (fine if fine is not None else coarse), 2)
 
 
 def travel_headings(points: FloatArray, initial: float) -> FloatArray:

@@ -5,18 +5,18 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from astralis_des.actions import coverage as cov
 from astralis_des.actions.common import footprint_spacing
 from astralis_des.actions.uav import WALL_MARGIN
-from astralis_des.detection import predict_pixels
+from astralis_des.detection import predict_pixels, swath
 from astralis_des.kernel.robot import Motion, Robot
-from astralis_des.kernel.scene import Scene
 from astralis_des.kinds import TARGET_SIZE
 from astralis_des.sensing import GeometricSensor
 from astralis_des.view import View
+from astralis_des.world import coverage as cov
 from astralis_des.world.catalogue import default_catalogue
 from astralis_des.world.geometry import Box
 from astralis_des.world.model import World
+from astralis_des.world.scene import Scene
 
 ROOM = Box((0.0, 0.0, 0.0), (4.0, 7.0, 3.0))
 
@@ -62,7 +62,7 @@ def test_spacing_follows_the_footprint() -> None:
     sitting target 1 cm inside half of it across the track shows 40 pixels somewhere along a
     pass, one 5 cm outside never does (90 x 106 degrees, 75 down, 320 x 240: about 5.5 m)."""
     view = View.of_kind("uav")
-    strip = view.swath(1.0)
+    strip = swath(view, 1.0)
     assert 5.0 < strip < 6.0
     assert footprint_spacing(robot(), 0.2) == pytest.approx(0.8 * strip)
     along = np.arange(-4.0, 4.0, 0.01)

@@ -126,7 +126,7 @@ def test_the_planner_map_and_the_physics_see_the_blocks(walled: World) -> None:
 
 def test_world_show_records_an_imported_world(tmp_path: Path) -> None:
     """``world show`` of the Autzen twin writes a recording with its cloud and blocks."""
-    from astralis_des.world.show import show_world
+    from astralis_des.sinks.world_show import show_world
 
     shown = show_world(ROOT / "worlds" / "autzen.yaml", [0.1], tmp_path / "autzen.rrd")
     assert shown.rooms == 4 and shown.path.stat().st_size > 400_000

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from astralis_des import Simulation, load_mission
-from astralis_des.kernel.scene import Mover
+from astralis_des.world.scene import Mover
 
 ROOT = Path(__file__).resolve().parents[1]
 CORRIDOR_Y = 78.25  # centre line of building A's ground-floor corridor

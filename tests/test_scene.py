@@ -13,13 +13,13 @@ import pytest
 from astralis_des import Mission, Simulation, load_mission
 from astralis_des.cli import main
 from astralis_des.kernel.robot import Robot
-from astralis_des.kernel.scene import Scene
-from astralis_des.kernel.world_state import AVATAR_VALUES
+from astralis_des.mission.draws import AVATAR_VALUES
 from astralis_des.sensing import GeometricSensor
 from astralis_des.view import View
 from astralis_des.world.catalogue import default_catalogue
 from astralis_des.world.clutter import Clutter, Placed
 from astralis_des.world.model import World
+from astralis_des.world.scene import Scene
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -12,10 +12,12 @@ from collections.abc import Callable
 from astralis_des.actions.common import ActionGen, Context
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task
+from astralis_des.plugins import ACTIONS as _ACTIONS
+from astralis_des.plugins import actions_for
 from astralis_des.registry import Registry
 
 Action = Callable[[Context, Robot, Task], ActionGen]
-ACTIONS: Registry[tuple[str, str], Action] = Registry("action")
+ACTIONS: Registry[tuple[str, str], Action] = _ACTIONS  # held in the foundations, by name
 
 from astralis_des.actions import human, move, uav, ugv  # noqa: E402,F401  (they register)
 
@@ -23,6 +25,4 @@ from astralis_des.actions import human, move, uav, ugv  # noqa: E402,F401  (they
 # a point: ``x`` and ``y`` params).
 ROOMLESS = frozenset({"hover"})
 
-
-def actions_for(kind: str) -> list[str]:
-    return [name for k, name in ACTIONS if k == kind]
+__all__ = ["ACTIONS", "ROOMLESS", "Action", "actions_for"]

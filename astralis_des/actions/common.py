@@ -3,34 +3,25 @@
 from __future__ import annotations
 
 from collections.abc import Generator
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 import simpy
 
+from astralis_des import detection
+from astralis_des.kernel.contracts import Context
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kernel.tasks import ActionResult, Task, TaskStatus
 from astralis_des.kinds import KIND_DEFAULTS, TARGET_HEIGHT
-from astralis_des.planning.navigator import Navigator, Route, level_legs
-from astralis_des.sensing import GeometricSensor, Sighting
+from astralis_des.planning.navigator import Route, level_legs
 from astralis_des.world.geometry import FloatArray
-from astralis_des.world.model import Room, World
+from astralis_des.world.model import Room
 
 DOOR_OFFSET = 0.6  # m in front of a door's wall: where robots stop by a door
 TURN_MARGIN = 0.1  # m kept between a wall and the circle a body sweeps turning on the spot
 LOOK_AROUND = 2.0  # s spent looking round a room that cannot be searched by its pattern
 ActionGen = Generator[simpy.Event, Any, ActionResult]
 StepGen = Generator[simpy.Event, Any, float]
-
-
-class CoSim(Protocol):
-    def execute(self, robot: Robot, motion: Motion) -> simpy.Event: ...
-    def watch(self, robot: Robot, motion: Motion, sensor: GeometricSensor,
-              done: simpy.Event) -> simpy.Event: ...
-    def dwell(self, robot: Robot, seconds: float) -> simpy.Event: ...
-    def face(self, robot: Robot, heading: float) -> simpy.Event: ...
-    def halt(self, robot: Robot) -> None: ...
-    def look(self, robot: Robot, sensor: GeometricSensor) -> Sighting | None: ...
 
 
 class MotionFailed(Exception):
@@ -40,18 +31,6 @@ class MotionFailed(Exception):
     def __init__(self, reason: str, fault: bool = False) -> None:
         super().__init__(reason)
         self.fault = fault
-
-
-class Context(Protocol):
-    """What a :class:`~astralis_des.kernel.simulation.Simulation` offers to actions."""
-
-    env: simpy.Environment
-    world: World
-    cosim: CoSim
-    sensor: GeometricSensor
-    navigator: Navigator
-
-    def report_detection(self, robot: Robot, sighting: Sighting) -> None: ...
 
 
 def result(status: TaskStatus, message: str, **kw: Any) -> ActionResult:
@@ -179,7 +158,7 @@ def footprint_spacing(robot: Robot, overlap: float) -> float:
     overlap (at least 0.5 m; 1 m for a robot without a camera)."""
     if robot.view is None:
         return 1.0
-    swath = robot.view.swath(max(robot.height - TARGET_HEIGHT, 0.0))
+    swath = detection.swath(robot.view, max(robot.height - TARGET_HEIGHT, 0.0))
     return float(max(swath * (1.0 - overlap), 0.5))
 
 

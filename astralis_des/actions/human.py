@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from astralis_des.actions import ACTIONS
-from astralis_des.actions import coverage as cov
 from astralis_des.actions.common import (
     ActionGen,
     Context,
@@ -14,6 +12,8 @@ from astralis_des.actions.common import (
 )
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task
+from astralis_des.plugins import ACTIONS
+from astralis_des.world import coverage as cov
 
 
 @ACTIONS.register(("human", "inspect"))

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from astralis_des.actions import ACTIONS
 from astralis_des.actions.common import ActionGen, Context, failed, go_to, room_of, stand_off
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task
 from astralis_des.kinds import KINDS
+from astralis_des.plugins import ACTIONS
 
 
 def move(ctx: Context, robot: Robot, task: Task) -> ActionGen:

@@ -3,8 +3,6 @@ sweep."""
 
 from __future__ import annotations
 
-from astralis_des.actions import ACTIONS
-from astralis_des.actions import coverage as cov
 from astralis_des.actions.common import (
     ActionGen,
     Context,
@@ -18,6 +16,8 @@ from astralis_des.actions.common import (
 )
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task, TaskStatus
+from astralis_des.plugins import ACTIONS
+from astralis_des.world import coverage as cov
 
 OVERLAP = 0.2  # share of the footprint that neighbouring passes see twice
 WALL_MARGIN = 1.0  # m: the outermost pass runs at most this far inside the walls, so that the

@@ -9,7 +9,6 @@ from typing import Any
 import numpy as np
 import simpy
 
-from astralis_des.actions import ACTIONS
 from astralis_des.actions.common import (
     ActionGen,
     Context,
@@ -24,6 +23,7 @@ from astralis_des.actions.common import (
 )
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task, TaskStatus
+from astralis_des.plugins import ACTIONS
 from astralis_des.world.model import Room
 
 SNEAK_OFFSET = 0.5  # m in front of the wall's face at least (more for a body that must turn)

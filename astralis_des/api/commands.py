@@ -13,10 +13,10 @@ from astralis_des.actions import ACTIONS, ROOMLESS, actions_for
 from astralis_des.api.ops import Args, NoArgs, op
 from astralis_des.api.protocol import MAX_PACE, MAX_TELEOP_STEP, ApiError
 from astralis_des.errors import InputError, suggest
-from astralis_des.kernel.timeline import book, dispatch
+from astralis_des.simulation.timeline import book, dispatch
 
 if TYPE_CHECKING:
-    from astralis_des.api.service import Service
+    from astralis_des.api.session import Session
     from astralis_des.kernel.robot import Robot
 
 COMPASS = {"north": (0.0, 1.0), "south": (0.0, -1.0), "east": (1.0, 0.0),
@@ -61,7 +61,7 @@ class TeleopArgs(Args):
     distance: float = Field(0.5, gt=0.0, le=MAX_TELEOP_STEP)
 
 
-def _task(svc: Service, args: TaskArgs) -> Robot:
+def _task(svc: Session, args: TaskArgs) -> Robot:
     """Check a task against the robot's kind, the world and the robot's state."""
     robot = svc.robot(args.robot)
     if (robot.kind, args.action) not in ACTIONS:
@@ -82,7 +82,7 @@ def _task(svc: Service, args: TaskArgs) -> Robot:
     return robot
 
 
-def _queued(svc: Service, args: TaskArgs, preempt: bool) -> dict[str, Any]:
+def _queued(svc: Session, args: TaskArgs, preempt: bool) -> dict[str, Any]:
     robot = _task(svc, args)
     handler = svc.sim.handler(robot.id)
     running = handler.current
@@ -99,19 +99,19 @@ def _queued(svc: Service, args: TaskArgs, preempt: bool) -> dict[str, Any]:
 
 
 @op("enqueue", EnqueueArgs, command=True)
-def _enqueue(svc: Service, args: EnqueueArgs) -> dict[str, Any]:
+def _enqueue(svc: Session, args: EnqueueArgs) -> dict[str, Any]:
     """Queue a task for a robot (after its others, or first with preempt: true)."""
     return _queued(svc, args, args.preempt)
 
 
 @op("preempt", TaskArgs, command=True)
-def _preempt(svc: Service, args: TaskArgs) -> dict[str, Any]:
+def _preempt(svc: Session, args: TaskArgs) -> dict[str, Any]:
     """Run a task now: the running task ends 'preempted', the queue waits behind."""
     return _queued(svc, args, True)
 
 
 @op("cancel", CancelArgs, command=True)
-def _cancel(svc: Service, args: CancelArgs) -> dict[str, Any]:
+def _cancel(svc: Session, args: CancelArgs) -> dict[str, Any]:
     """Cancel one task of a robot, running or queued, or all of them."""
     robot = svc.robot(args.robot)
     handler = svc.sim.handler(robot.id)
@@ -127,7 +127,7 @@ def _cancel(svc: Service, args: CancelArgs) -> dict[str, Any]:
 
 
 @op("pause", NoArgs, command=True)
-def _pause(svc: Service, args: Args) -> dict[str, Any]:
+def _pause(svc: Session, args: Args) -> dict[str, Any]:
     """Stop the clock; time then moves only on step (or resume)."""
     svc.command_event("pause")
     svc.clock.running = False
@@ -135,7 +135,7 @@ def _pause(svc: Service, args: Args) -> dict[str, Any]:
 
 
 @op("resume", ResumeArgs, command=True)
-def _resume(svc: Service, args: ResumeArgs) -> dict[str, Any]:
+def _resume(svc: Session, args: ResumeArgs) -> dict[str, Any]:
     """Start the clock again, at the pace given or the one it had."""
     svc.command_event("resume", pace=args.pace)
     if args.pace is not None:
@@ -146,7 +146,7 @@ def _resume(svc: Service, args: ResumeArgs) -> dict[str, Any]:
 
 
 @op("step", StepArgs, command=True)
-def _step(svc: Service, args: StepArgs) -> dict[str, Any]:
+def _step(svc: Session, args: StepArgs) -> dict[str, Any]:
     """With the clock paused: run the mission to a time (until) or for a while (by)."""
     if svc.clock.running:
         raise ApiError("clock_running", f"the clock is {svc.clock.describe()}; pause it first "
@@ -165,7 +165,7 @@ def _step(svc: Service, args: StepArgs) -> dict[str, Any]:
 
 
 @op("assign", AssignArgs, command=True)
-def _assign(svc: Service, args: AssignArgs) -> dict[str, Any]:
+def _assign(svc: Session, args: AssignArgs) -> dict[str, Any]:
     """Run an assignment round now (Eq. 1) over a segment's rooms and queue its tasks."""
     sim = svc.sim
     segment = sim.world.segments.get(args.segment)
@@ -192,7 +192,7 @@ def _assign(svc: Service, args: AssignArgs) -> dict[str, Any]:
 
 
 @op("teleop", TeleopArgs, command=True)
-def _teleop(svc: Service, args: TeleopArgs) -> dict[str, Any]:
+def _teleop(svc: Session, args: TeleopArgs) -> dict[str, Any]:
     """Walk (drive, fly) a robot a step north, south, east or west, now; steps add up."""
     robot = svc.robot(args.robot)
     if robot.faulted:
@@ -217,7 +217,7 @@ def _teleop(svc: Service, args: TeleopArgs) -> dict[str, Any]:
     return {"task": task.id, "robot": robot.id, "goal": goal.tolist()}
 
 
-def _check_step(svc: Service, robot: Robot, here: np.ndarray, goal: np.ndarray) -> None:
+def _check_step(svc: Session, robot: Robot, here: np.ndarray, goal: np.ndarray) -> None:
     """A teleoperated step goes straight: not off the site, into a wall or round one."""
     world = svc.sim.world
     where = ", ".join(f"{v:.2f}" for v in goal[:2])
@@ -234,7 +234,7 @@ def _check_step(svc: Service, robot: Robot, here: np.ndarray, goal: np.ndarray) 
 
 
 @op("shutdown", NoArgs, command=True)
-def _shutdown(svc: Service, args: Args) -> dict[str, Any]:
+def _shutdown(svc: Session, args: Args) -> dict[str, Any]:
     """End the mission where it is (its outputs are written) and stop the server."""
     if not svc.ended:
         svc.command_event("shutdown")

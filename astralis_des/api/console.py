@@ -7,14 +7,15 @@ from typing import Any
 
 from rich.console import Console
 
-from astralis_des.cli import EXIT_INTERRUPTED
+from astralis_des.exits import EXIT_INTERRUPTED
 
 
 def serve_command(args: argparse.Namespace) -> int:
     from astralis_des.api.server import Server
-    from astralis_des.api.service import Clock, Service
-    from astralis_des.cli import mission_from_args
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.api.service import Service
+    from astralis_des.api.session import Clock
+    from astralis_des.mission.overrides import mission_from_args
+    from astralis_des.simulation import Simulation
 
     if args.state_rate <= 0:
         from astralis_des.errors import InputError

@@ -11,9 +11,10 @@ from typing import Any
 
 from astralis_des.api.protocol import ApiError
 from astralis_des.api.server import Server
-from astralis_des.api.service import Clock, Service
-from astralis_des.kernel.result import RunResult
+from astralis_des.api.service import Service
+from astralis_des.api.session import Clock
 from astralis_des.mission.loader import Mission
+from astralis_des.simulation.result import RunResult
 
 
 class Background:
@@ -42,7 +43,7 @@ class Background:
         return self.address
 
     def _main(self) -> None:
-        from astralis_des.kernel.simulation import Simulation
+        from astralis_des.simulation import Simulation
 
         a = self._args
         server = None

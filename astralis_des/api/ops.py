@@ -18,9 +18,9 @@ from astralis_des.api.protocol import ApiError
 from astralis_des.registry import Registry
 
 if TYPE_CHECKING:
-    from astralis_des.api.service import Service
+    from astralis_des.api.session import Session
 
-Handler = Callable[["Service", Any], dict[str, Any]]
+Handler = Callable[["Session", Any], dict[str, Any]]
 
 
 class Args(BaseModel):
@@ -54,7 +54,8 @@ class Op:
         return f"{self.name}({', '.join(parts)})"
 
 
-OPS: Registry[str, Op] = Registry("op")
+OPS: Registry[str, Op] = Registry(
+    "op", plugins=("astralis_des.api.commands", "astralis_des.api.queries"))
 
 
 def op(name: str, args: type[Args] = NoArgs, *,

@@ -9,14 +9,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from pydantic import Field
 
-from astralis_des import __version__
 from astralis_des.actions import actions_for
 from astralis_des.api.ops import OPS, Args, op
 from astralis_des.api.protocol import MAX_MESSAGE, PROTOCOL
 from astralis_des.kernel.robot import Motion
+from astralis_des.version import __version__
 
 if TYPE_CHECKING:
-    from astralis_des.api.service import Service
+    from astralis_des.api.session import Session
     from astralis_des.kernel.robot import Robot
     from astralis_des.kernel.tasks import Task
 
@@ -47,14 +47,14 @@ class EventsArgs(Args):
 
 
 @op("help")
-def _help(svc: Service, args: Args) -> dict[str, Any]:
+def _help(svc: Session, args: Args) -> dict[str, Any]:
     """The operations, their arguments (! = required) and what each does."""
     return {"ops": {name: {"usage": OPS.get(name).usage(), "help": OPS.get(name).help,
                            "command": OPS.get(name).command} for name in OPS}}
 
 
 @op("info")
-def _info(svc: Service, args: Args) -> dict[str, Any]:
+def _info(svc: Session, args: Args) -> dict[str, Any]:
     """The mission, its team and their actions, the rooms, segments and addresses."""
     sim, spec = svc.sim, svc.sim.mission.spec
     world = sim.world
@@ -71,7 +71,7 @@ def _info(svc: Service, args: Args) -> dict[str, Any]:
 
 
 @op("status", OptionalRobot)
-def _status(svc: Service, args: OptionalRobot) -> dict[str, Any]:
+def _status(svc: Session, args: OptionalRobot) -> dict[str, Any]:
     """The mission's time, clock, outcome and each robot's state (or one robot's)."""
     sim = svc.sim
     robots = ([svc.robot(args.robot)] if args.robot is not None
@@ -88,7 +88,7 @@ def _status(svc: Service, args: OptionalRobot) -> dict[str, Any]:
 
 
 @op("avatar")
-def _avatar(svc: Service, args: Args) -> dict[str, Any]:
+def _avatar(svc: Session, args: Args) -> dict[str, Any]:
     """The target avatar's attributes (Table II); its location once it has been found."""
     target = svc.sim.target
     out: dict[str, Any] = {TABLE_II_AVATAR[k]: v for k, v in target.avatar.items()}
@@ -100,7 +100,7 @@ def _avatar(svc: Service, args: Args) -> dict[str, Any]:
 
 
 @op("location", RoomArgs)
-def _location(svc: Service, args: RoomArgs) -> dict[str, Any]:
+def _location(svc: Session, args: RoomArgs) -> dict[str, Any]:
     """A room's location, messiness_level, risk and sound (Table II)."""
     room = svc.room(args.room)
     state = svc.sim.rooms[room.id]
@@ -110,13 +110,13 @@ def _location(svc: Service, args: RoomArgs) -> dict[str, Any]:
 
 
 @op("robot", RobotArgs)
-def _robot(svc: Service, args: RobotArgs) -> dict[str, Any]:
+def _robot(svc: Session, args: RobotArgs) -> dict[str, Any]:
     """A robot's type, pose and command (Table II), and its state."""
     return robot_state(svc, svc.robot(args.robot))
 
 
 @op("queue", RobotArgs)
-def _queue(svc: Service, args: RobotArgs) -> dict[str, Any]:
+def _queue(svc: Session, args: RobotArgs) -> dict[str, Any]:
     """A robot's running task and the tasks waiting, in the order they will run."""
     robot = svc.robot(args.robot)
     handler = svc.sim.handler(robot.id)
@@ -126,7 +126,7 @@ def _queue(svc: Service, args: RobotArgs) -> dict[str, Any]:
 
 
 @op("events", EventsArgs)
-def _events(svc: Service, args: EventsArgs) -> dict[str, Any]:
+def _events(svc: Session, args: EventsArgs) -> dict[str, Any]:
     """The log's events at or after ``since`` and past ``after``, oldest first (or only the
     ``last`` N); ``next`` is the ``after`` of the following page, ``total`` the log's length."""
     records = svc.sim.log.records
@@ -166,7 +166,7 @@ def _time(rec: dict[str, Any]) -> float:
 
 
 # -- shared with the state stream ----------------------------------------------------------
-def robot_state(svc: Service, robot: Robot) -> dict[str, Any]:
+def robot_state(svc: Session, robot: Robot) -> dict[str, Any]:
     now = svc.now
     handler = svc.sim.handler(robot.id)
     current = handler.current

@@ -1,6 +1,6 @@
 """The mission behind the API: requests in, replies out, no sockets.
 
-:class:`Service` owns a started :class:`~astralis_des.kernel.simulation.Simulation` and its
+:class:`Service` owns a started :class:`~astralis_des.simulation.core.Simulation` and its
 :class:`Clock`. The server (:mod:`.server`) moves time on and hands it frames; tests and the
 in-process chat can call :meth:`Service.handle` directly.
 """
@@ -8,21 +8,20 @@ in-process chat can call :meth:`Service.handle` directly.
 from __future__ import annotations
 
 import logging
-import time
 from collections import OrderedDict
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from astralis_des.api import commands, queries  # noqa: F401  (they register their ops)
 from astralis_des.api.ops import OPS
 from astralis_des.api.protocol import ApiError, decode, encode, finite
+from astralis_des.api.session import Clock
 from astralis_des.errors import suggest
 from astralis_des.registry import UnknownEntry
 
 if TYPE_CHECKING:
-    from astralis_des.kernel.result import RunResult
     from astralis_des.kernel.robot import Robot
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.simulation import Simulation
+    from astralis_des.simulation.result import RunResult
     from astralis_des.world.model import Room
 
 log = logging.getLogger(__name__)
@@ -30,28 +29,9 @@ REPLAYS = 1024  # replies to commands kept by connection and request id: a retry
 # twice (and two clients that both count their ids from 1 do not meet)
 
 
-class Clock:
-    """Simulated time against wall time: running at ``pace`` (1 = real time), or paused
-    (time then moves only on ``step``)."""
-
-    def __init__(self, pace: float = 1.0, running: bool = True) -> None:
-        self.pace = pace
-        self.running = running
-        self._wall0 = time.perf_counter()
-        self._sim0 = 0.0
-
-    def anchor(self, sim_now: float) -> None:
-        self._wall0, self._sim0 = time.perf_counter(), sim_now
-
-    def target(self) -> float:
-        """The simulated time it is now, by the wall clock."""
-        return self._sim0 + (time.perf_counter() - self._wall0) * self.pace
-
-    def describe(self) -> str:
-        return f"running at {self.pace:g}x" if self.running else "paused"
-
-
 class Service:
+    """A started mission answering requests (a :class:`~astralis_des.api.session.Session`)."""
+
     def __init__(self, sim: Simulation, clock: Clock | None = None) -> None:
         self.sim = sim
         self.clock = clock or Clock()

@@ -13,6 +13,7 @@ from astralis_des.assignment.eq1 import Agent, RoomInfo, Weights, distances, eq1
 from astralis_des.assignment.matching import match
 from astralis_des.assignment.rules import table4_action
 from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.plugins import STRATEGIES as _STRATEGIES
 from astralis_des.registry import Registry
 
 
@@ -56,7 +57,7 @@ class Strategy:
         return self.costs(agents, rooms, weights)
 
 
-STRATEGIES: Registry[str, Strategy] = Registry("assignment strategy")
+STRATEGIES: Registry[str, Strategy] = _STRATEGIES  # held in the foundations, by name
 
 
 def register_strategy(name: str, matcher: str | None = None) -> Callable[[Costs], Costs]:

@@ -20,7 +20,7 @@ from astralis_des.chat import robots
 from astralis_des.chat.language import Parsed, complete, help_rows, parse
 from astralis_des.chat.show import events_text, queue_text, reply, unwrapped
 from astralis_des.chat.team import ChatError, Team
-from astralis_des.cli import EXIT_INTERRUPTED
+from astralis_des.exits import EXIT_INTERRUPTED
 from astralis_des.registry import Registry
 
 if TYPE_CHECKING:
@@ -225,7 +225,7 @@ def chat_command(args: argparse.Namespace) -> int:
 
 def _serve_here(args: argparse.Namespace, console: Console) -> tuple[Any, Path, str]:
     from astralis_des.api.local import Background
-    from astralis_des.cli import mission_from_args
+    from astralis_des.mission.overrides import mission_from_args
 
     mission, out = mission_from_args(args)
     background = Background(mission, pace=args.pace, running=not args.stepped, out_dir=out)

@@ -22,8 +22,8 @@ from rich.text import Text
 from astralis_des.api.protocol import MAX_TELEOP_STEP, ApiError
 from astralis_des.chat.keys import QUIT, KeyDecoder
 from astralis_des.chat.show import where
-from astralis_des.cli import EXIT_INTERRUPTED
 from astralis_des.errors import InputError, suggest
+from astralis_des.exits import EXIT_INTERRUPTED
 
 if TYPE_CHECKING:
     from astralis_des.api.client import Client

@@ -7,11 +7,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from astralis_des.registry import Registry
+from astralis_des.plugins import COSIMS
 
-COSIMS: Registry[str, Any] = Registry("fidelity")
-
-from astralis_des.cosim import kinematic  # noqa: E402,F401  (registers itself)
+__all__ = ["COSIMS", "load_fidelity"]
 
 
 def load_fidelity(name: str) -> Any:

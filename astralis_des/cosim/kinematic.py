@@ -3,27 +3,16 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import simpy
 
-from astralis_des.cosim import COSIMS
+from astralis_des.kernel.contracts import Host, MotionOutcome, Sensor
 from astralis_des.kernel.robot import Motion, Robot
-from astralis_des.sensing import GeometricSensor, Sighting
+from astralis_des.plugins import COSIMS
 
 if TYPE_CHECKING:
-    from astralis_des.kernel.simulation import Simulation
-
-
-@dataclass(frozen=True)
-class MotionOutcome:
-    """How a motion ended: arrived, or failed with a reason (stuck, left the world, ...).
-    ``fault``: the robot cannot go on (it crashed, fell): it leaves the mission."""
-
-    ok: bool
-    reason: str
-    fault: bool = False
+    from astralis_des.detection import Sighting
 
 
 ARRIVED = MotionOutcome(True, "arrived")
@@ -31,7 +20,7 @@ ARRIVED = MotionOutcome(True, "arrived")
 
 @COSIMS.register("kinematic")
 class KinematicCoSim:
-    def __init__(self, sim: Simulation) -> None:
+    def __init__(self, sim: Host) -> None:
         self.env = sim.env
 
     def execute(self, robot: Robot, motion: Motion) -> simpy.Event:
@@ -39,13 +28,13 @@ class KinematicCoSim:
         robot.begin(motion, self.env.now)
         return self.env.timeout(motion.duration, value=ARRIVED)
 
-    def watch(self, robot: Robot, motion: Motion, sensor: GeometricSensor,
+    def watch(self, robot: Robot, motion: Motion, sensor: Sensor,
               done: simpy.Event) -> simpy.Event:
         """An event that succeeds with the first sighting along the motion (never if none)."""
         hit = sensor.first_sighting(robot, motion)
         return self.env.timeout(hit.t, value=hit) if hit is not None else self.env.event()
 
-    def look(self, robot: Robot, sensor: GeometricSensor) -> Sighting | None:
+    def look(self, robot: Robot, sensor: Sensor) -> Sighting | None:
         """What the robot's camera sees from where it stands now (around, if it pans)."""
         return sensor.sighting_from(robot, robot.position(self.env.now), self.env.now)
 

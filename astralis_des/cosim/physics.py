@@ -15,15 +15,14 @@ import shutil
 import tempfile
 from collections.abc import Callable, Generator
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import simpy
 
-from astralis_des.cosim import COSIMS
-from astralis_des.cosim.kinematic import MotionOutcome
+from astralis_des.detection import Sighting
+from astralis_des.kernel.contracts import Host, MotionOutcome, Sensor
 from astralis_des.kernel.robot import Motion, Robot
-from astralis_des.kernel.scene import Mover
 from astralis_des.physics.client import PhysicsClient
 from astralis_des.physics.drivers import DRIVERS, Driver, HumanDriver
 from astralis_des.physics.hexacopter import write_urdf
@@ -34,12 +33,10 @@ from astralis_des.physics.make_way import aside
 from astralis_des.physics.perception import Perception
 from astralis_des.physics.track import Track
 from astralis_des.physics.ugv_driver import UgvDriver
-from astralis_des.sensing import GeometricSensor, Sighting
+from astralis_des.plugins import COSIMS
 from astralis_des.world.clutter import Clutter
 from astralis_des.world.geometry import FloatArray
-
-if TYPE_CHECKING:
-    from astralis_des.kernel.simulation import Simulation
+from astralis_des.world.scene import Mover
 
 CONTACT_CHECKS_PER_S = 30
 PROGRESS = 0.1  # m of its path a moving robot must make good within stuck_timeout
@@ -52,7 +49,7 @@ RISE_AHEAD = 1.0  # s: a waiting UAV that a walking avatar reaches this soon has
 
 @COSIMS.register("physics")
 class PhysicsCoSim:
-    def __init__(self, sim: Simulation) -> None:
+    def __init__(self, sim: Host) -> None:
         spec = sim.mission.spec.physics
         self.env, self.log, self.spec = sim.env, sim.log, spec
         self.world = sim.world
@@ -92,7 +89,7 @@ class PhysicsCoSim:
         self._ticks = 0
         self.env.process(self._stepper())
 
-    def _add_scene(self, sim: Simulation) -> None:
+    def _add_scene(self, sim: Host) -> None:
         """The target and the movers now; each room's furniture (one static body) and its
         patrolling avatars when the room is furnished, before any robot goes in."""
         scene = sim.scene
@@ -236,12 +233,12 @@ class PhysicsCoSim:
             self.drivers[robot.id].freeze()
         robot.halt(self.env.now)
 
-    def watch(self, robot: Robot, motion: Motion, sensor: GeometricSensor,
+    def watch(self, robot: Robot, motion: Motion, sensor: Sensor,
               done: simpy.Event) -> simpy.Event:
         """Look for the target in rendered frames while the body moves."""
         return self.perception.watch(robot, done)
 
-    def look(self, robot: Robot, sensor: GeometricSensor) -> Sighting | None:
+    def look(self, robot: Robot, sensor: Sensor) -> Sighting | None:
         """Render what the robot's camera sees from where it waits (around, if it pans)."""
         return self.perception.look(robot)
 

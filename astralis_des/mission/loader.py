@@ -8,8 +8,9 @@ from typing import Any
 
 from astralis_des.errors import InputError, suggest
 from astralis_des.mission.spec import CommandEvent, MissionSpec
+from astralis_des.plugins import ACTIONS, SENSORS, STRATEGIES, actions_for
 from astralis_des.registry import UnknownEntry
-from astralis_des.validation import validate
+from astralis_des.validation import check_unique_ids, validate
 from astralis_des.world.build import load_world
 from astralis_des.world.catalogue import Catalogue, default_catalogue, load_catalogue
 from astralis_des.world.model import World
@@ -91,25 +92,7 @@ def _check_imu_rates(spec: MissionSpec, doc: LocatedYaml) -> None:
                             f"than the physics control_rate {control} Hz")
 
 
-def check_unique_ids(doc: LocatedYaml, key: str) -> None:
-    """Point at the second use of an id in the list ``key``, with the line of the first."""
-    items = doc.data.get(key) if isinstance(doc.data, dict) else None
-    seen: dict[object, int] = {}
-    for i, item in enumerate(items if isinstance(items, list) else []):
-        ident = item.get("id") if isinstance(item, dict) else None
-        if ident is None or not isinstance(ident, str | int):
-            continue
-        if ident in seen:
-            first = doc.line_of((key, seen[ident], "id"))
-            raise doc.error((key, i, "id"), f"id '{ident}' is used twice"
-                            + (f" (first at line {first})" if first else ""))
-        seen[ident] = i
-
-
 def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None:
-    from astralis_des.actions import ACTIONS, actions_for
-    from astralis_des.assignment.strategies import STRATEGIES
-
     def room(value: str, path: KeyPath) -> None:
         if value not in world.rooms:
             raise doc.error(path, f"no room '{value}' in world '{world.name}'; "
@@ -140,6 +123,12 @@ def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None
         raise doc.error(("target", "position"), "a target position needs target.room as well")
     kinds = {m.id: m.kind for m in spec.team}
     for i, member in enumerate(spec.team):
+        for name in member.sensor_set.plugins:
+            if name not in SENSORS:
+                known = list(SENSORS)
+                raise doc.error(("team", i, "sensors", "plugins", name), f"no sensor '{name}'; "
+                                + (suggest(name, known) if known else "none is registered "
+                                   "(astralis_des.plugins.SENSORS)"))
         if isinstance(member.start, str):
             room(member.start, ("team", i, "start"))
         else:

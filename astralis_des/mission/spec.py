@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
@@ -73,6 +73,9 @@ class SensorsSpec(Strict):
     camera: CameraSpec | None = Field(default_factory=CameraSpec)
     lidar: LidarSpec | None = None
     imu: ImuSpec | None = None
+    plugins: dict[str, dict[str, Any]] = Field(
+        default_factory=dict, description="sensors added by name (registered in "
+        "astralis_des.plugins.SENSORS), each with its parameters: {name: {param: value}}")
 
 
 SENSORS = ("camera", "lidar", "imu")

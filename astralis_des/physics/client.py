@@ -9,9 +9,11 @@ from typing import Any
 import numpy as np
 import pybullet as pb
 import pybullet_data
+from numpy.typing import NDArray
 
-from astralis_des.physics.planar import BoxIndex
+from astralis_des.physics.planar import BoxIndex, crossings, cut
 from astralis_des.physics.quiet import quiet_c_output
+from astralis_des.world.geometry import FloatArray
 from astralis_des.world.model import BLOCK, World
 
 __all__ = ["GRAVITY", "PhysicsClient", "quiet_c_output"]
@@ -131,3 +133,25 @@ class PhysicsClient:
     def close(self) -> None:
         with contextlib.suppress(pb.error):
             pb.disconnect(physicsClientId=self.id)
+
+
+def beams_near_bodies(client: PhysicsClient, centre: FloatArray, directions: FloatArray,
+                      start: float, stop: FloatArray) -> NDArray[np.intp]:
+    """The rays (from ``start`` to each one's ``stop``) that cross the bounding box of a body
+    part that is not a static box: the only ones Bullet need follow. The broadphase names the
+    parts near the centre; the ground plane counts only for rays at or below it."""
+    reach = float(stop.max(initial=0.0))
+    x, y, z = (float(v) for v in centre)
+    near = client.call("getOverlappingObjects", [x - reach, y - reach, z - 1e-3],
+                       [x + reach, y + reach, z + 1e-3]) or ()
+    parts = [(b, link) for b, link in near
+             if b not in client.boxes.bodies and (b != client.ground or z <= 0.0)]
+    if not parts:
+        return np.empty(0, dtype=np.intp)
+    boxes = np.array([client.call("getAABB", b, link) for b, link in parts])
+    near_boxes = cut(boxes[:, 0], boxes[:, 1], centre, reach)
+    if len(near_boxes) == 0:
+        return np.empty(0, dtype=np.intp)
+    enter = crossings(boxes[near_boxes, 0], boxes[near_boxes, 1], centre, directions, start,
+                      stop, inside=True)
+    return np.flatnonzero(np.isfinite(enter).any(axis=0))

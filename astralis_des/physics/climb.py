@@ -14,7 +14,7 @@ from astralis_des.physics.drivers import SAMPLE
 from astralis_des.world.geometry import FloatArray
 
 if TYPE_CHECKING:
-    from astralis_des.physics.local import Body
+    from astralis_des.physics.courses import Body
 
 CLIMB_MARGIN = 0.3  # m a climbing UAV keeps above a walker's head
 MAX_CLIMB = 0.8  # m: a UAV climbs at most this far above its course

@@ -49,7 +49,8 @@ class Driver(Protocol):
     def recover(self, at: FloatArray) -> None: ...
 
 
-DRIVERS: Registry[str, type] = Registry("driver")
+DRIVERS: Registry[str, type] = Registry(
+    "driver", plugins=("astralis_des.physics.uav_driver", "astralis_des.physics.ugv_driver"))
 
 
 class Avoiding:
@@ -187,5 +188,3 @@ def samples_along(points: FloatArray, cum: FloatArray, start: float,
     s = np.append(np.arange(start, end, SAMPLE), end)
     return np.column_stack([np.interp(s, cum, points[:, k]) for k in range(points.shape[1])])
 
-
-from astralis_des.physics import uav_driver, ugv_driver  # noqa: E402,F401  (they register)

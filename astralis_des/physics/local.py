@@ -24,19 +24,18 @@ an avatar in the next room is no reason to move. The rules, as people keep to in
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from astralis_des.physics.climb import MOVER_AHEAD, Climber
-from astralis_des.physics.courses import on_route
+from astralis_des.physics.courses import Body, on_route
 from astralis_des.physics.drivers import SAMPLE
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
 if TYPE_CHECKING:
-    from astralis_des.cosim.physics import PhysicsCoSim
     from astralis_des.physics.drivers import Driver
+    from astralis_des.physics.engine import Engine
 
 PASS_RANGE = 5.0  # m: closer than this, head-on, both keep right
 BRAKING = 1.0  # s: the stopping range grows by this times the robot's speed
@@ -60,25 +59,8 @@ ROUND_MARGIN = 0.05  # m beyond the lane a robot stepping round a standing body 
 MAKE_WAY_PATH = 6.0  # m of the asking robot's path that a robot making way keeps off
 
 
-@dataclass
-class Body:
-    name: str
-    kind: str  # a robot kind, or what a mover is (avatar, obstacle), or "lift"
-    xy: FloatArray
-    velocity: FloatArray  # xy: zero while it holds
-    z: tuple[float, float]
-    radius: float  # how far it reaches ahead and behind (a disc round it)
-    rank: int  # lower yields to higher; movers rank above every robot
-    base_z: tuple[float, float] = (0.0, 0.0)  # a UAV's band before any climb
-    offset: FloatArray = field(default_factory=lambda: np.zeros(2))  # its shift off its path
-    half_width: float = 0.0  # how far it reaches to the side (a long body's less than radius)
-
-    def __post_init__(self) -> None:
-        self.half_width = self.half_width or self.radius
-
-
 class LocalLayer:
-    def __init__(self, cosim: PhysicsCoSim, order: list[str]) -> None:
+    def __init__(self, cosim: Engine, order: list[str]) -> None:
         self.cosim = cosim
         self.rank = {rid: len(order) - i for i, rid in enumerate(order)}
         self.holds = 0  # how many times a robot was held (for tests and benchmarks)

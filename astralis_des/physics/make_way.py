@@ -12,14 +12,14 @@ from astralis_des.physics.local import DOOR_BUSY, RADII
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
 if TYPE_CHECKING:
-    from astralis_des.cosim.physics import PhysicsCoSim
     from astralis_des.kernel.robot import Robot
+    from astralis_des.physics.engine import Engine
 
 ASIDE_STEPS = (1.0, 1.5, 2.0)  # m: how far a robot making way may go
 ASIDE_DIRECTIONS = 16
 
 
-def aside(cosim: PhysicsCoSim, robot: Robot, here: FloatArray, path: FloatArray,
+def aside(cosim: Engine, robot: Robot, here: FloatArray, path: FloatArray,
           asker_kind: str) -> FloatArray | None:
     """The nearest spot (at ``here``'s height, on the same floor) where ``robot`` is clear of
     ``path`` by both bodies' radii and a margin, fits among walls and furniture, is not in a

@@ -39,8 +39,8 @@ from astralis_des.view import View, look_headings
 from astralis_des.world.geometry import FloatArray
 
 if TYPE_CHECKING:
-    from astralis_des.cosim.physics import PhysicsCoSim
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.kernel.contracts import Host
+    from astralis_des.physics.engine import Engine
 
 AHEAD = math.radians(25.0)  # half-angle of the lidar sector a UGV slows down for
 SLOW_AT = 1.5  # m from the lidar: nearer than this ahead, a UGV slows down ...
@@ -100,7 +100,7 @@ class ImuTrace:
 class Eyes:
     """A robot's camera: full resolution to detect, half to keep frames."""
 
-    def __init__(self, cosim: PhysicsCoSim, robot: Robot, spec: CameraSpec, view: View) -> None:
+    def __init__(self, cosim: Engine, robot: Robot, spec: CameraSpec, view: View) -> None:
         body = cosim.drivers[robot.id].body
         mount = _mount(cosim, robot.id)
         self.spec, self.view = spec, view
@@ -116,7 +116,7 @@ class Eyes:
 class Perception:
     """Cameras, lidars and IMUs of a physics run."""
 
-    def __init__(self, cosim: PhysicsCoSim, sim: Simulation) -> None:
+    def __init__(self, cosim: Engine, sim: Host) -> None:
         self.cosim, self.env = cosim, sim.env
         self.clock = SensorClock()
         self.frames: list[KeptFrame] = []
@@ -286,7 +286,7 @@ class Perception:
             trace.times.append(self.env.now)
 
 
-def _mount(cosim: PhysicsCoSim, robot_id: str) -> FloatArray:
+def _mount(cosim: Engine, robot_id: str) -> FloatArray:
     """Where the robot's sensors sit in its body frame: at the pose the fidelity reports."""
     driver = cosim.drivers[robot_id]
     base, quat = cosim.client.call("getBasePositionAndOrientation", driver.body)

@@ -11,17 +11,12 @@ out, slowed every physics step by a quarter.)
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 from numpy.typing import NDArray
 
 from astralis_des.world.geometry import FloatArray
 
-if TYPE_CHECKING:
-    from astralis_des.physics.client import PhysicsClient
-
-__all__ = ["BoxIndex", "beams_near_bodies", "crossings"]
+__all__ = ["BoxIndex", "crossings", "cut"]
 
 TINY = 1e-12  # a direction component smaller than this is taken as this (no 0 / 0)
 
@@ -49,7 +44,7 @@ def crossings(lo: FloatArray, hi: FloatArray, centre: FloatArray, directions: Fl
     return enter
 
 
-def _cut(lo: FloatArray, hi: FloatArray, centre: FloatArray, reach: float) -> NDArray[np.intp]:
+def cut(lo: FloatArray, hi: FloatArray, centre: FloatArray, reach: float) -> NDArray[np.intp]:
     """The boxes the rays' plane cuts within ``reach`` of their centre."""
     x, y, z = (float(v) for v in centre)
     gap_x = np.maximum(np.maximum(lo[:, 0] - x, x - hi[:, 0]), 0.0)
@@ -82,32 +77,11 @@ class BoxIndex:
         """The nearest box along each horizontal ray from ``start`` to ``stop``: its distance
         and body, or ``inf`` and -1 where the ray meets none."""
         rays = len(directions)
-        cut = _cut(self.lo, self.hi, centre, stop)
-        if len(cut) == 0:
+        near = cut(self.lo, self.hi, centre, stop)
+        if len(near) == 0:
             return np.full(rays, np.inf), np.full(rays, -1, dtype=np.int32)
-        enter = crossings(self.lo[cut], self.hi[cut], centre, directions, start, stop)
+        enter = crossings(self.lo[near], self.hi[near], centre, directions, start, stop)
         nearest = np.argmin(enter, axis=0)
         t = enter[nearest, np.arange(rays)]
-        body = np.where(np.isfinite(t), self.body[cut][nearest], -1).astype(np.int32)
+        body = np.where(np.isfinite(t), self.body[near][nearest], -1).astype(np.int32)
         return t, body
-
-
-def beams_near_bodies(client: PhysicsClient, centre: FloatArray, directions: FloatArray,
-                      start: float, stop: FloatArray) -> NDArray[np.intp]:
-    """The rays (from ``start`` to each one's ``stop``) that cross the bounding box of a body
-    part that is not a static box: the only ones Bullet need follow. The broadphase names the
-    parts near the centre; the ground plane counts only for rays at or below it."""
-    reach = float(stop.max(initial=0.0))
-    x, y, z = (float(v) for v in centre)
-    near = client.call("getOverlappingObjects", [x - reach, y - reach, z - 1e-3],
-                       [x + reach, y + reach, z + 1e-3]) or ()
-    parts = [(b, link) for b, link in near
-             if b not in client.boxes.bodies and (b != client.ground or z <= 0.0)]
-    if not parts:
-        return np.empty(0, dtype=np.intp)
-    boxes = np.array([client.call("getAABB", b, link) for b, link in parts])
-    cut = _cut(boxes[:, 0], boxes[:, 1], centre, reach)
-    if len(cut) == 0:
-        return np.empty(0, dtype=np.intp)
-    enter = crossings(boxes[cut, 0], boxes[cut, 1], centre, directions, start, stop, inside=True)
-    return np.flatnonzero(np.isfinite(enter).any(axis=0))

@@ -19,8 +19,7 @@ import numpy as np
 import pybullet as pb
 from numpy.typing import NDArray
 
-from astralis_des.physics.client import GRAVITY, PhysicsClient
-from astralis_des.physics.planar import beams_near_bodies
+from astralis_des.physics.client import GRAVITY, PhysicsClient, beams_near_bodies
 from astralis_des.world.geometry import FloatArray
 
 __all__ = ["Camera", "Frame", "Imu", "ImuReading", "Intrinsics", "Lidar2D", "Scan"]

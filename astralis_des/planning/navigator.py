@@ -12,7 +12,7 @@ import itertools
 import math
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -21,9 +21,10 @@ from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
 if TYPE_CHECKING:
-    from astralis_des.kernel.robot import Robot
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.mission.spec import MissionSpec
     from astralis_des.planning.occupancy import GridMap, VoxelMap
+    from astralis_des.world.model import World
+    from astralis_des.world.scene import Scene
 
 BODY_RADIUS = {"uav": 0.3, "ugv": 0.35, "human": 0.25}  # m, a disc around the body's centre
 # m more kept from furniture and people than from walls: a UAV cuts a corner of its path by
@@ -43,10 +44,16 @@ class Route:
     skipped: int = 0  # points left out as unreachable (``refine(..., skip=True)``)
 
 
+class Robot(Protocol):
+    """What routing needs of a robot (the kernel's robots are such)."""
+
+    kind: str  # uav, ugv or human: what it may use (stairs, ramps, the lift) and its body
+    height: float  # m above the floor of its sensor: where its route runs
+
+
 class Navigator:
-    def __init__(self, sim: Simulation) -> None:
-        spec = sim.mission.spec
-        self.world, self.scene, self.cfg = sim.world, sim.scene, spec.planning
+    def __init__(self, world: World, scene: Scene, spec: MissionSpec) -> None:
+        self.world, self.scene, self.cfg = world, scene, spec.planning
         method = self.cfg.method
         self.method = method if method != "auto" else (
             "map" if spec.fidelity == "physics" else "graph")

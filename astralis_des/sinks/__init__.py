@@ -9,10 +9,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 from astralis_des.kernel.events import Record
+from astralis_des.simulation.outputs import OUTPUTS
 
 if TYPE_CHECKING:
-    from astralis_des.kernel.result import RunResult
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.simulation import Simulation
+    from astralis_des.simulation.result import RunResult
 
 
 class Output(Protocol):
@@ -77,6 +78,7 @@ def write_atomic(path: Path, text: str) -> None:
     os.replace(tmp, path)
 
 
+@OUTPUTS.register("files")
 def open_sinks(sim: Simulation, out_dir: Path | None) -> Outputs:
     """Open what the mission's ``outputs`` asks for under ``out_dir`` (nothing without one)."""
     t0 = time.perf_counter()

@@ -18,8 +18,8 @@ from astralis_des.world.clutter import Placed
 from astralis_des.world.model import BLOCK, World
 
 if TYPE_CHECKING:
-    from astralis_des.kernel.result import RunResult
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.simulation import Simulation
+    from astralis_des.simulation.result import RunResult
 
 SOLID_COLORS = {"wall": (170, 170, 180, 255), "slab": (120, 120, 130, 60)}
 OBSTACLE_COLOR = (60, 140, 60, 255)

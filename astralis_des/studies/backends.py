@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from astralis_des.errors import InputError
 from astralis_des.registry import Registry, UnknownEntry
-from astralis_des.studies.runner import ChunkResult, run_chunk
+from astralis_des.studies.scenarios import ChunkResult, run_chunk
 
 if TYPE_CHECKING:
     from astralis_des.studies.spec import Study

@@ -10,8 +10,8 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
-from astralis_des.cli import EXIT_INTERRUPTED
 from astralis_des.errors import InputError
+from astralis_des.exits import EXIT_INTERRUPTED
 from astralis_des.studies.backends import make_backend
 from astralis_des.studies.reports import TextTable, report
 from astralis_des.studies.runner import run_scenario, run_study

@@ -15,8 +15,8 @@ from astralis_des.studies.eval_assignment import team_ids
 from astralis_des.studies.evaluation import Metric, evaluation
 
 if TYPE_CHECKING:
-    from astralis_des.kernel.simulation import Simulation
     from astralis_des.mission.loader import Mission
+    from astralis_des.simulation import Simulation
     from astralis_des.studies.draws import Scenario
     from astralis_des.studies.factors import Setting
     from astralis_des.studies.spec import Study, Variant
@@ -57,7 +57,7 @@ def scenario_mission(study: Study, scenario: Scenario, s: Setting, outputs: bool
 @evaluation("mission", METRICS, tradeoff=("human_high_risk_s", "ugv_high_mess_s"))
 def evaluate_mission(study: Study, scenario: Scenario, variant: Variant,
                      out_dir: Path | None) -> dict[str, Any]:
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.simulation import Simulation
 
     s = variant.setting
     sim = Simulation(scenario_mission(study, scenario, s, out_dir is not None), out_dir=out_dir)

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from astralis_des.registry import Registry
+from astralis_des.studies import registries
 
 if TYPE_CHECKING:
     from astralis_des.studies.draws import Scenario
@@ -36,7 +37,7 @@ class Evaluation:
     tradeoff: tuple[str, str]  # the trade-off plot's x and y metric columns
 
 
-EVALUATIONS: Registry[str, Evaluation] = Registry("study evaluation")
+EVALUATIONS: Registry[str, Evaluation] = registries.EVALUATIONS
 
 
 def evaluation(name: str, metrics: tuple[Metric, ...],
@@ -47,8 +48,3 @@ def evaluation(name: str, metrics: tuple[Metric, ...],
 
     return add
 
-
-def load_evaluations() -> None:
-    """Import the modules that register evaluations."""
-    import astralis_des.studies.eval_assignment
-    import astralis_des.studies.eval_mission  # noqa: F401

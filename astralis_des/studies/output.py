@@ -24,10 +24,11 @@ from typing import TYPE_CHECKING
 import pyarrow as pa
 
 from astralis_des.errors import InputError
+from astralis_des.studies.results import WRITERS
 from astralis_des.studies.table import write_table
 
 if TYPE_CHECKING:
-    from astralis_des.studies.runner import StudyResult
+    from astralis_des.studies.results import StudyResult
 
 
 @contextmanager
@@ -54,6 +55,7 @@ def staging(folder: Path | None) -> Iterator[Path | None]:
     shutil.rmtree(old, ignore_errors=True)
 
 
+@WRITERS.register("folder")
 def write_folder(result: StudyResult, folder: Path) -> Path:
     with staging(folder) as tmp:
         assert tmp is not None
@@ -62,8 +64,8 @@ def write_folder(result: StudyResult, folder: Path) -> Path:
 
 
 def fill_folder(result: StudyResult, folder: Path) -> None:
-    from astralis_des import __version__
     from astralis_des.studies.reports import report
+    from astralis_des.version import __version__
 
     study = result.study
     write_table(result.table, folder)

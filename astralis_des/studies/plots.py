@@ -13,7 +13,7 @@ from astralis_des.registry import Registry
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from astralis_des.studies.runner import StudyResult
+    from astralis_des.studies.results import StudyResult
 
 Summary = list[dict[str, Any]]
 
@@ -112,7 +112,7 @@ def tradeoff_plot(result: StudyResult, summary: Summary) -> Figure:
     traces the trade-off); for missions, coloured by the mean time to find."""
     import matplotlib.pyplot as plt
 
-    from astralis_des.studies.runner import evaluation_of
+    from astralis_des.studies.scenarios import evaluation_of
 
     x_col, y_col = evaluation_of(result.study).tradeoff
     by = {(e["variant"], e["metric"]): e for e in summary}
@@ -171,7 +171,7 @@ def grid_plot(result: StudyResult, summary: Summary) -> Figure:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from astralis_des.studies.runner import evaluation_of
+    from astralis_des.studies.scenarios import evaluation_of
 
     axes_names = _grid_axes(result)
     assert axes_names is not None

@@ -10,10 +10,11 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from astralis_des.registry import Registry
+from astralis_des.studies import registries
 from astralis_des.studies.table import format_estimate
 
 if TYPE_CHECKING:
-    from astralis_des.studies.runner import StudyResult
+    from astralis_des.studies.results import StudyResult
 
 
 @dataclass(frozen=True)
@@ -33,7 +34,7 @@ class TextTable:
 
 
 Report = Callable[["StudyResult"], list[TextTable]]
-REPORTS: Registry[str, Report] = Registry("study report")
+REPORTS: Registry[str, Report] = registries.REPORTS
 
 
 @REPORTS.register("summary")
@@ -53,11 +54,5 @@ def summary_report(result: StudyResult) -> list[TextTable]:
                       ["variant", "runs", "failed", *metrics], rows)]
 
 
-def load_reports() -> None:
-    """Import the modules that register reports."""
-    import astralis_des.studies.table5  # noqa: F401
-
-
 def report(result: StudyResult) -> list[TextTable]:
-    load_reports()
     return REPORTS.get(result.study.spec.report)(result)

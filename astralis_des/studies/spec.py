@@ -27,6 +27,7 @@ from astralis_des.mission.spec import Strict
 from astralis_des.registry import UnknownEntry
 from astralis_des.studies.draws import FromMission, Positions, Sampler, Scenario, draw_scenario
 from astralis_des.studies.factors import FACTORS, Setting, base_setting, label
+from astralis_des.studies.registries import EVALUATIONS, REPORTS
 from astralis_des.validation import validate
 from astralis_des.yamlio import KeyPath, LocatedYaml, load_yaml
 
@@ -152,11 +153,6 @@ def make_study(mission: Mission | str | Path, *, name: str, scenarios: int,
 
 
 def _build(spec: StudySpec, mission: Mission, doc: LocatedYaml, text: str) -> Study:
-    from astralis_des.studies.evaluation import EVALUATIONS, load_evaluations
-    from astralis_des.studies.reports import REPORTS, load_reports
-
-    load_evaluations()
-    load_reports()
     for key, registry in (("evaluate", EVALUATIONS), ("report", REPORTS)):
         try:
             registry.get(getattr(spec, key))

@@ -15,7 +15,7 @@ from astralis_des.studies.reports import REPORTS, TextTable, summary_report
 from astralis_des.studies.table import Z95, format_estimate
 
 if TYPE_CHECKING:
-    from astralis_des.studies.runner import StudyResult
+    from astralis_des.studies.results import StudyResult
 
 PAPER_N = 1000
 PAPER: dict[str, dict[str, float]] = {

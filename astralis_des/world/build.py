@@ -66,8 +66,7 @@ def _road_box(start: tuple[float, float], end: tuple[float, float], width: float
 @lru_cache(maxsize=16)
 def load_world(path: Path) -> World:
     """Read, validate and build a world file; cached, since a world never changes."""
-    from astralis_des.mission.loader import check_unique_ids
-    from astralis_des.validation import validate
+    from astralis_des.validation import check_unique_ids, validate
     from astralis_des.yamlio import load_yaml
 
     doc = load_yaml(path)

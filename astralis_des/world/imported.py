@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 
 from astralis_des.errors import InputError
 from astralis_des.world.geometry import Box, FloatArray
-from astralis_des.world.model import BLOCK, Door, Room, Segment, Solid
+from astralis_des.world.parts import BLOCK, Door, Room, Segment, Solid
 from astralis_des.world.spec import AreaSpec, GeometrySpec, SourceSpec
 from astralis_des.yamlio import LocatedYaml
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from typing import Protocol
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -12,7 +13,7 @@ from scipy.sparse.csgraph import shortest_path
 
 from astralis_des.errors import InputError
 from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
-from astralis_des.world.model import BLOCK, World
+from astralis_des.world.parts import BLOCK, Building, Room, Solid, Space
 
 KINDS = ("uav", "ugv", "human")
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
@@ -25,10 +26,31 @@ SNAP = 0.5  # m: a point this close to a room or corridor (in a wall, by a door)
 NOT_BLOCKERS = ("wall", "slab", BLOCK)
 
 
+class Site(Protocol):
+    """What routing needs of a world (:class:`~astralis_des.world.model.World` is one)."""
+
+    @property
+    def buildings(self) -> dict[str, Building]: ...
+    @property
+    def rooms(self) -> dict[str, Room]: ...
+    @property
+    def spaces(self) -> dict[str, Space]: ...
+    @property
+    def solids(self) -> tuple[Solid, ...]: ...
+    @property
+    def block_array(self) -> FloatArray: ...
+    @property
+    def areas(self) -> list[Room]: ...
+    @property
+    def stairs_passable_by(self) -> dict[str, tuple[str, ...]]: ...
+    def contains(self, point: tuple[float, ...] | FloatArray) -> bool: ...
+    def room_at(self, point: tuple[float, ...] | FloatArray) -> Room | None: ...
+
+
 class Router:
     """Shortest routes between arbitrary points, for each agent kind."""
 
-    def __init__(self, world: World) -> None:
+    def __init__(self, world: Site) -> None:
         self.world = world
         self.names: list[str] = []
         self.index: dict[str, int] = {}

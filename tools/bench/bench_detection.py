@@ -96,7 +96,7 @@ def classify(sim: Any) -> str:
 
 
 def one(job: tuple[int, str]) -> dict[str, Any]:
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.simulation import Simulation
     from astralis_des.studies import load_study
     from astralis_des.studies.eval_mission import scenario_mission
 

@@ -44,7 +44,7 @@ def cause(message: str) -> str:
 
 def one(job: tuple[int, str, str]) -> dict[str, Any]:
     """Scenario ``index`` under ``strategy`` in ``fidelity``: what the benchmark tabulates."""
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.simulation import Simulation
     from astralis_des.studies import load_study
     from astralis_des.studies.eval_mission import scenario_mission
 

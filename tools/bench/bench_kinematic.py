@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from astralis_des import Simulation, load_mission  # noqa: E402
-from astralis_des.kernel.result import RunResult  # noqa: E402
+from astralis_des.simulation.result import RunResult  # noqa: E402
 
 
 def timed(fn):  # type: ignore[no-untyped-def]

@@ -168,8 +168,8 @@ def bench_coverage() -> None:
     """(e) Share of each room's free floor a UAV's search pattern sees, over the 18 rooms of
     building A, empty (messiness 0) and furnished at messiness 1."""
     from astralis_des import Simulation, load_mission
-    from astralis_des.actions import coverage as cov
     from astralis_des.actions.common import footprint_spacing, plane_to_floor
+    from astralis_des.world import coverage as cov
 
     base = load_mission(ROOT / "missions" / "urban_search.yaml")
     patterns = {

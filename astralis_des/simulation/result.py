@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 from astralis_des.kernel.events import Record, plain
 
 if TYPE_CHECKING:
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.simulation.contracts import Run
 
 
 @dataclass(frozen=True)
@@ -65,7 +65,7 @@ class RunResult:
         return summary
 
 
-def build_result(sim: Simulation, outcome: str, wall_time: float) -> RunResult:
+def build_result(sim: Run, outcome: str, wall_time: float) -> RunResult:
     now = float(sim.env.now)
     stats = {}
     for rid, robot in sim.robots.items():
@@ -92,7 +92,7 @@ def build_result(sim: Simulation, outcome: str, wall_time: float) -> RunResult:
         sensor_time=dict(sorted(clock.seconds.items())) if clock else {})
 
 
-def room_report(sim: Simulation) -> dict[str, dict[str, Any]]:
+def room_report(sim: Run) -> dict[str, dict[str, Any]]:
     """Each room of the searched segments: ``searched`` (seen at least ``min_coverage``),
     ``undercovered`` (counted searched though no search saw that much: no agent of another
     kind was left), ``given_up``, or ``not_searched``; the most of it one search saw, and who

@@ -10,11 +10,11 @@ from pathlib import Path
 from typing import Any
 
 from astralis_des.errors import InputError
-from astralis_des.kernel.scene import Scene
-from astralis_des.kernel.world_state import RoomState
+from astralis_des.mission.draws import RoomState
 from astralis_des.world.build import load_world
 from astralis_des.world.catalogue import default_catalogue, load_catalogue
 from astralis_des.world.model import World
+from astralis_des.world.scene import Scene
 
 
 @dataclass(frozen=True)

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from astralis_des.kernel.scene import Scene, Target
 from astralis_des.mission.loader import Mission
 from astralis_des.streams import stream
+from astralis_des.world.scene import Scene, Target
 
 SOUNDS = ("minimal", "moderate", "loud")
 AVATAR_VALUES: dict[str, tuple[object, ...]] = {

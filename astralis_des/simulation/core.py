@@ -16,21 +16,24 @@ from astralis_des.actions import ACTIONS
 from astralis_des.actions.common import MotionFailed
 from astralis_des.assignment import Agent, Assignment, RoomInfo, Weights, assign
 from astralis_des.cosim import load_fidelity
+from astralis_des.kernel.contracts import PluginSensor
 from astralis_des.kernel.events import EventLog
 from astralis_des.kernel.handler import TaskHandler
-from astralis_des.kernel.result import RunResult, build_result
 from astralis_des.kernel.robot import Robot
-from astralis_des.kernel.scene import Scene
 from astralis_des.kernel.tasks import ActionResult, Stop, Task, TaskStatus
-from astralis_des.kernel.timeline import scheduled, search
-from astralis_des.kernel.world_state import draw_rooms, draw_target
 from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.mission.draws import draw_rooms, draw_target
 from astralis_des.mission.loader import Mission
 from astralis_des.mission.spec import MemberSpec
 from astralis_des.planning.navigator import Navigator
+from astralis_des.plugins import SENSORS
 from astralis_des.sensing import GeometricSensor, Sighting
+from astralis_des.simulation.outputs import OUTPUTS
+from astralis_des.simulation.result import RunResult, build_result
+from astralis_des.simulation.timeline import scheduled, search
 from astralis_des.streams import stream
 from astralis_des.view import View
+from astralis_des.world.scene import Scene
 
 log = logging.getLogger(__name__)
 Progress = Callable[[float, float], None]
@@ -73,8 +76,12 @@ class Simulation:
         self._sinks: Any = None
         self._wall0 = time.perf_counter()
         self.robots = {m.id: self._make_robot(m) for m in spec.team}
-        self.navigator = Navigator(self)
+        self.navigator = Navigator(self.world, self.scene, spec)
         self.cosim = load_fidelity(spec.fidelity)(self)
+        self.sensors: dict[str, dict[str, PluginSensor]] = {  # robot -> name -> plug-in
+            m.id: {name: SENSORS.get(name)(self, self.robots[m.id], params)
+                   for name, params in m.sensor_set.plugins.items()}
+            for m in spec.team if m.sensor_set.plugins}
 
     # -- set-up ----------------------------------------------------------------------------
     def _not_placed(self, room: str, kind: str, reason: str) -> None:
@@ -232,13 +239,11 @@ class Simulation:
 
     def start(self) -> None:
         """Open the outputs and start the timeline; ``advance`` then moves time on."""
-        from astralis_des.sinks import open_sinks
-
         if self._end is not None:
             return
         spec = self.mission.spec
         self._wall0 = time.perf_counter()
-        self._sinks = open_sinks(self, self.out_dir)
+        self._sinks = OUTPUTS.get("files")(self, self.out_dir)
         if self._progress is not None:
             progress = self._progress
             self.log.sinks.append(lambda rec: progress(rec["t"], spec.time_limit))
@@ -251,6 +256,9 @@ class Simulation:
             ends.append(self._timeline)
         for event in spec.timeline:
             self.env.process(scheduled(self, event))
+        for mine in self.sensors.values():
+            for sensor in mine.values():
+                self.env.process(sensor.run())
         self._limit = self.env.timeout(spec.time_limit)
         self._end = simpy.AnyOf(self.env, [*ends, self._limit])
         for held in self._held:

@@ -16,9 +16,9 @@ from typing import Any
 
 import numpy as np
 
-from astralis_des.actions import coverage as cov
 from astralis_des.kinds import TARGET_HEIGHT
 from astralis_des.streams import stream
+from astralis_des.world import coverage as cov
 from astralis_des.world.catalogue import Catalogue
 from astralis_des.world.clutter import Clutter, Placed, free_spot, place_room
 from astralis_des.world.geometry import Box, FloatArray, boxes_array, segments_hit_boxes

@@ -20,13 +20,13 @@ from astralis_des.registry import Registry
 
 if TYPE_CHECKING:
     from astralis_des.assignment import Assignment
-    from astralis_des.kernel.simulation import Simulation
+    from astralis_des.simulation.contracts import Run
 
-Handler = Callable[["Simulation", Any], None]
+Handler = Callable[["Run", Any], None]
 TIMELINE_EVENTS: Registry[str, Handler] = Registry("timeline event")
 
 
-def search(sim: Simulation) -> Generator[simpy.Event, Any, str]:
+def search(sim: Run) -> Generator[simpy.Event, Any, str]:
     """Search each segment in turn; a round matches the free agents to its pending rooms.
 
     A room whose search failed (no route, stuck) stays pending for the next round, up to
@@ -72,7 +72,7 @@ def search(sim: Simulation) -> Generator[simpy.Event, Any, str]:
     return "not_found"
 
 
-def _undercovered(sim: Simulation, room: str, robot: Any, outcome: ActionResult) -> bool:
+def _undercovered(sim: Run, room: str, robot: Any, outcome: ActionResult) -> bool:
     """Whether a search that succeeded saw too little of ``room`` and another kind of agent
     can still search it; a ``room_undercovered`` event says so either way."""
     threshold = sim.mission.spec.assignment.min_coverage
@@ -85,7 +85,7 @@ def _undercovered(sim: Simulation, room: str, robot: Any, outcome: ActionResult)
     return bool(others)
 
 
-def _settle(sim: Simulation, room: str, why: str) -> None:
+def _settle(sim: Run, room: str, why: str) -> None:
     """A pending room no agent may take: searched as far as seen, if it was; else given up."""
     if room in sim.tried:
         sim.searched.append(room)
@@ -94,7 +94,7 @@ def _settle(sim: Simulation, room: str, why: str) -> None:
         sim.log.emit("room_given_up", room=room, attempts=0, reason=why)
 
 
-def dispatch(sim: Simulation, plan: Assignment) -> dict[str, simpy.Event]:
+def dispatch(sim: Run, plan: Assignment) -> dict[str, simpy.Event]:
     """Queue each matched agent's tasks, go to the door and search the room; the events
     succeed with the searches' results, by room."""
     searches = {}
@@ -105,30 +105,30 @@ def dispatch(sim: Simulation, plan: Assignment) -> dict[str, simpy.Event]:
     return searches
 
 
-def book(sim: Simulation, searches: dict[str, simpy.Event]) -> Generator[simpy.Event, Any, None]:
+def book(sim: Run, searches: dict[str, simpy.Event]) -> Generator[simpy.Event, Any, None]:
     """Count the rooms of a round asked for by hand as searched once their searches succeed."""
     yield simpy.AllOf(sim.env, list(searches.values()))
     sim.searched.extend(room for room, done in searches.items()
                         if cast(ActionResult, done.value).ok and room not in sim.searched)
 
 
-def scheduled(sim: Simulation, event: Any) -> Generator[simpy.Event, Any, None]:
+def scheduled(sim: Run, event: Any) -> Generator[simpy.Event, Any, None]:
     yield sim.env.timeout(event.at - sim.env.now)
     TIMELINE_EVENTS.get(event.event)(sim, event)
 
 
 @TIMELINE_EVENTS.register("fault")
-def _fault(sim: Simulation, event: FaultEvent) -> None:
+def _fault(sim: Run, event: FaultEvent) -> None:
     sim.fault(sim.robots[event.robot], event.reason)
 
 
 @TIMELINE_EVENTS.register("recover")
-def _recover(sim: Simulation, event: RecoverEvent) -> None:
+def _recover(sim: Run, event: RecoverEvent) -> None:
     sim.recover(sim.robots[event.robot])
 
 
 @TIMELINE_EVENTS.register("room_change")
-def _room_change(sim: Simulation, event: RoomChangeEvent) -> None:
+def _room_change(sim: Run, event: RoomChangeEvent) -> None:
     state = sim.rooms[event.room]
     changes = event.model_dump(include={"risk", "messiness", "sound"}, exclude_none=True)
     for key, value in changes.items():
@@ -137,7 +137,7 @@ def _room_change(sim: Simulation, event: RoomChangeEvent) -> None:
 
 
 @TIMELINE_EVENTS.register("command")
-def _command(sim: Simulation, event: CommandEvent) -> None:
+def _command(sim: Run, event: CommandEvent) -> None:
     sim.log.emit("command", event.robot, action=event.action, room=event.room,
                  params=dict(event.params), preempt=event.preempt)
     sim.enqueue(event.robot, event.action, event.room, dict(event.params), origin="timeline",
@@ -145,6 +145,6 @@ def _command(sim: Simulation, event: CommandEvent) -> None:
 
 
 @TIMELINE_EVENTS.register("cancel")
-def _cancel(sim: Simulation, event: CancelEvent) -> None:
+def _cancel(sim: Run, event: CancelEvent) -> None:
     cancelled = sim.handler(event.robot).cancel(reason="cancelled by the timeline")
     sim.log.emit("cancel", event.robot, tasks=[t.id for t in cancelled])

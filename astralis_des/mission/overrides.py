@@ -1,0 +1,30 @@
+"""A mission as the command line and its front ends (``serve``, ``chat``) ask for it: the file
+with ``--seed``, ``--fidelity``, ``--no-recording`` and ``--manual`` applied, and its output
+folder."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from astralis_des.errors import InputError
+from astralis_des.mission.loader import Mission, load_mission
+
+
+def mission_from_args(args: argparse.Namespace) -> tuple[Mission, Path]:
+    """The mission file with the command line's overrides, and its output folder."""
+    mission = load_mission(args.mission)
+    if args.seed is not None:
+        mission = mission.with_changes(seed=args.seed)
+    if args.fidelity is not None:
+        mission = mission.with_changes(fidelity=args.fidelity)
+    if args.no_recording:
+        outputs = mission.spec.outputs.model_copy(update={"recording": False})
+        mission = mission.with_changes(outputs=outputs.model_dump())
+    if getattr(args, "manual", False):  # serve and chat
+        assignment = mission.spec.assignment.model_copy(update={"auto": False})
+        mission = mission.with_changes(assignment=assignment.model_dump())
+    out = Path(args.out or mission.spec.outputs.dir or Path("out") / mission.name)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"{out} exists and is not a folder", key="--out")
+    return mission, out
