@@ -198,3 +198,25 @@ def test_a_uav_coming_down_from_a_lifted_point_does_not_come_down_onto_a_walker(
         assert course - 0.1 + need >= walker.z[1] + 0.3 - 1e-9  # over the walker's head
     assert climber.need(uav, [walker], uav.velocity, ahead[:, :2], ahead[:, :2], True,
                         paths)[0] == 0.0  # judged at its hover height alone: the crash
+
+
+def test_a_uav_setting_off_meets_the_walkers_where_they_are_now() -> None:
+    """Scenario 6 (mixed) of the physics outcome study: while no robot moved near it, a
+    patrolling avatar's body was left where it last was, on the spot a UAV waited at; its
+    script walked on. When the UAV set off, the stale body was still in it: a contact, and
+    the UAV tipped over. A robot setting off now puts every mover where it is."""
+    sim = corridor_mission([{"id": "uav1", "kind": "uav", "start": [70.0, CORRIDOR_Y, 0.0]}])
+    add_walker(sim, [(75.0, CORRIDOR_Y), (79.0, CORRIDOR_Y)])  # 5 m and more away
+    sim.start()
+    hop = sim.enqueue("uav1", "move", params={"x": 70.5, "y": CORRIDOR_Y})  # then it waits
+    sim.advance(10.0)
+    assert hop.triggered and hop.value.ok
+    _, body = sim.cosim.movers[-1]
+    here = sim.cosim.drivers["uav1"].position()
+    sim.cosim.client.call("resetBasePositionAndOrientation", body,  # left behind on its spot
+                          [here[0] + 0.2, here[1], 0.86], [0.0, 0.0, 0.0, 1.0])
+    done = sim.enqueue("uav1", "move", params={"x": 66.0, "y": CORRIDOR_Y})
+    sim.advance(20.0)
+    assert done.triggered and done.value.ok, done.value.message
+    assert [e for e in sim.log.records if e["kind"] in ("contact", "fault")] == []
+    sim.finish()

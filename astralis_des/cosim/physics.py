@@ -169,6 +169,15 @@ class PhysicsCoSim:
             reset("resetBasePositionAndOrientation", body, mover.position_at(then).tolist(),
                   [0.0, 0.0, 0.0, 1.0])
 
+    def _place_movers(self) -> None:
+        """Every mover where it is now, as a robot sets off: a body not moved while no robot
+        was near it stays where it was last simulated, and a robot setting off there would
+        meet it (a UAV waiting where a patrolling avatar had stopped being moved was tipped
+        over by it)."""
+        for mover, body in self.movers:
+            self.client.call("resetBasePositionAndOrientation", body,
+                             mover.position_at(self.env.now).tolist(), [0.0, 0.0, 0.0, 1.0])
+
     # -- the co-simulation contract ------------------------------------------------------
     def execute(self, robot: Robot, motion: Motion) -> simpy.Event:
         self.halt(robot)
@@ -219,6 +228,7 @@ class PhysicsCoSim:
         robot.begin(track, self.env.now)  # type: ignore[arg-type]
         done = self.env.event()
         self.active[robot.id] = (robot, track, done)
+        self._place_movers()
         self.perception.moving(robot, done)
         if not self._wake.triggered:
             self._wake.succeed()
