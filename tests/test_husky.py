@@ -3,12 +3,27 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
 from astralis_des.physics.client import PhysicsClient
 from astralis_des.physics.husky import Husky
 from astralis_des.world.model import World
+
+
+def one_ugv(start: list[float], fidelity: str = "physics", time_limit: float = 500.0) -> Any:
+    """Building A's world (fig7) with one UGV at ``start``, no clutter, nobody assigned (the
+    search starts after ``time_limit - 100`` s): a stage for driving it by hand."""
+    from conftest import MISSIONS
+
+    from astralis_des import Simulation, load_mission
+
+    base = load_mission(MISSIONS / "fig7.yaml")
+    return Simulation(base.with_changes(
+        fidelity=fidelity, team=[{"id": "ugv1", "kind": "ugv", "start": start}],
+        scene={"clutter": False}, time_limit=time_limit, target={"room": "B.1.1.1"},
+        assignment={**base.spec.assignment.model_dump(), "start_at": time_limit - 100.0}))
 
 
 def test_lateral_velocity_stays_near_zero_on_a_curve(world: World) -> None:
@@ -47,16 +62,9 @@ def test_a_sneak_peek_at_every_door_of_building_a_touches_no_wall() -> None:
     """One UGV looks into all 18 rooms of building A in turn, riding the lift between
     floors: every sneak peek succeeds, the robot stops where it can turn on the spot (its
     half-diagonal and a margin from the wall), and its body never touches a wall."""
-    from conftest import MISSIONS
-
-    from astralis_des import Simulation, load_mission
     from astralis_des.actions.common import stand_off
 
-    base = load_mission(MISSIONS / "fig7.yaml")
-    sim = Simulation(base.with_changes(
-        fidelity="physics", team=[{"id": "ugv1", "kind": "ugv", "start": [70.0, 78.25, 0.0]}],
-        scene={"clutter": False}, time_limit=5000, target={"room": "B.1.1.1"},
-        assignment={**base.spec.assignment.model_dump(), "start_at": 4000.0}))
+    sim = one_ugv([70.0, 78.25, 0.0], time_limit=5000.0)
     robot = sim.robots["ugv1"]
     assert stand_off(robot, 0.5) > 0.61 + 0.05  # the Husky's half-diagonal, and a margin
     sim.start()
@@ -75,17 +83,10 @@ def test_a_husky_arriving_at_speed_stops_before_it_turns_to_look() -> None:
     peek), the Husky looks from the door point, not half a metre past it: it brakes to a
     stop before turning on the spot (turning while still rolling at 0.6 m/s carried it
     0.5 m on, out of line with the doorway)."""
-    from conftest import MISSIONS
-
-    from astralis_des import Simulation, load_mission
     from astralis_des.actions.common import stand_off
     from astralis_des.actions.ugv import SNEAK_OFFSET
 
-    base = load_mission(MISSIONS / "fig7.yaml")
-    sim = Simulation(base.with_changes(
-        fidelity="physics", team=[{"id": "ugv1", "kind": "ugv", "start": [77.0, 78.6, 0.0]}],
-        scene={"clutter": False}, time_limit=500, target={"room": "B.1.1.1"},
-        assignment={**base.spec.assignment.model_dump(), "start_at": 400.0}))
+    sim = one_ugv([77.0, 78.6, 0.0])
     robot = sim.robots["ugv1"]
     room = sim.world.rooms["A.1.1.3"]
     door = np.asarray(room.door_point("corridor", offset=stand_off(robot, SNEAK_OFFSET)))
@@ -105,17 +106,9 @@ def test_a_husky_turning_back_to_the_corridor_takes_the_kinematic_time() -> None
     and curves the rest (the kinematic profile turned on the spot all the way: 15% slower),
     and while it turns back its lidar's slow-down looks the way it is headed, not at the
     corridor's wall it turns away from (it crept at 0.2 m/s for 3 s: 30% slower)."""
-    from conftest import MISSIONS
-
-    from astralis_des import Simulation, load_mission
-
-    base = load_mission(MISSIONS / "fig7.yaml")
     times = {}
     for fidelity in ("kinematic", "physics"):
-        sim = Simulation(base.with_changes(
-            fidelity=fidelity, team=[{"id": "ugv1", "kind": "ugv", "start": [74.0, 77.6, 0.0]}],
-            scene={"clutter": False}, time_limit=500, target={"room": "B.1.1.1"},
-            assignment={**base.spec.assignment.model_dump(), "start_at": 400.0}))
+        sim = one_ugv([74.0, 77.6, 0.0], fidelity)
         sim.start()
         north = sim.enqueue("ugv1", "move", params={"x": 74.0, "y": 78.69})
         sim.advance(15.0)

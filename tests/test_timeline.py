@@ -6,9 +6,9 @@ it made with ``Mission.with_changes``; without ``out_dir`` a run writes nothing.
 In the unchanged mission round 1 (t=0) sends uav1 to A.1.1.2 and uav2 to A.1.1.3, each with a
 ``move`` to the door (uav1 arrives at t~21.9, uav2 at t~19.9) then a spiral, and ugv1 to
 observe the corridor of A.1.1.1; it sees 85% of that room, under the 90% a room needs, so
-round 2 (t~59.0) sends uav1 to search A.1.1.1 again; round 3 starts at t~78.0 on segment
-A.1.2, and uav1 finds the target in A.1.2.1 at t~90.8 (0.7 s later since the UAVs' passes
-rise over furniture and standing people instead of flying through them).
+round 2 (t~54.1) sends uav1 to search A.1.1.1 again; round 3 starts at t~73.9 on segment
+A.1.2, and uav1 finds the target in A.1.2.1 at t~85.9 (the UGV turns on the spot only
+beyond 60 degrees off its way, as the physics Husky does: its look ends 5 s sooner).
 """
 
 from __future__ import annotations
