@@ -3,8 +3,8 @@ higher one provides (the mission file checks action and strategy names; the acti
 need the kernel, register them). Each names the modules whose import fills it, imported on
 the first look-up (:class:`~astralis_des.registry.Registry`'s ``plugins``).
 
-To add an action, a strategy, a fidelity or a sensor, register it in a module of your own and import
-that module before running (or add it to the ``plugins`` here)::
+To add an action, a strategy, a fidelity or a sensor, register it in a module of your own
+and import that module before running (or add it to the ``plugins`` here)::
 
     from astralis_des.plugins import ACTIONS
 
