@@ -12,7 +12,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from astralis_des.exits import EXIT_BAD_INPUT, EXIT_INTERRUPTED
+from astralis_des.exits import EXIT_BAD_INPUT, EXIT_INTERRUPTED, interrupt_on_termination
 
 if TYPE_CHECKING:
     from astralis_des.simulation.result import RunResult
@@ -110,6 +110,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         _parser().print_help()
         return 0
+    interrupt_on_termination()
     from astralis_des.errors import InputError
 
     try:

@@ -13,6 +13,7 @@ from astralis_des.errors import InputError, suggest
 from astralis_des.yamlio import KeyPath, LocatedYaml
 
 M = TypeVar("M", bound=BaseModel)
+SHOWN = 40  # characters of a bad string value quoted in an error
 
 
 def validate(model: type[M], doc: LocatedYaml, *, context: dict[str, Any] | None = None) -> M:
@@ -25,7 +26,9 @@ def validate(model: type[M], doc: LocatedYaml, *, context: dict[str, Any] | None
 
 def _to_input_error(model: type[BaseModel], doc: LocatedYaml, exc: ValidationError) -> InputError:
     error = _most_useful(exc.errors())
-    path: KeyPath = tuple(p for p in error["loc"] if isinstance(p, str | int))
+    # a scalar union's member shows as its type ("tuple[...]"): the file has no such key
+    path: KeyPath = tuple(p for p in error["loc"] if isinstance(p, int)
+                          or (isinstance(p, str) and "[" not in p))
     path = _drop_union_tags(model, path)
     if error["type"] == "extra_forbidden":
         key = str(path[-1])
@@ -45,7 +48,9 @@ def _to_input_error(model: type[BaseModel], doc: LocatedYaml, exc: ValidationErr
         message = message[len("Value error, "):]
     if error["type"] not in ("value_error", "assertion_error") and "input" in error:
         value = error["input"]
-        if isinstance(value, str | int | float | bool):
+        if isinstance(value, str) and len(value) > SHOWN:
+            message += f" (got {value[:SHOWN]!r}..., {len(value):,} characters)"
+        elif isinstance(value, str | int | float | bool):
             message += f" (got {value!r})"
     return doc.error(path, message)
 

@@ -137,6 +137,34 @@ def _scalar(node: yaml.ScalarNode, builder: _Builder, path: KeyPath) -> Any:
         raise builder._fail(node, f"YAML error: {exc.problem}", path) from None
 
 
+MAX_DEPTH = 64  # lists and mappings nested deeper than this are refused (no file needs it)
+
+
+def _check_depth(text: str, path: Path) -> None:
+    """Refuse nesting deeper than ``MAX_DEPTH``, naming the line and the top-level key, before
+    the (recursive) composer meets it: the parser's events come one at a time."""
+    depth, key, expect_key = 0, None, False
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        if isinstance(event, yaml.CollectionStartEvent):
+            if depth == 1:
+                expect_key = False
+            depth += 1
+            if depth == 1:
+                expect_key = isinstance(event, yaml.MappingStartEvent)
+            if depth > MAX_DEPTH:
+                mark = event.start_mark
+                raise InputError(f"nested more than {MAX_DEPTH} levels deep", file=path,
+                                 line=mark.line + 1 if mark is not None else None, key=key)
+        elif isinstance(event, yaml.CollectionEndEvent):
+            depth -= 1
+            if depth == 1:
+                expect_key = True
+        elif isinstance(event, yaml.ScalarEvent) and depth == 1:
+            if expect_key:
+                key = event.value
+            expect_key = not expect_key
+
+
 def load_yaml(file: str | Path) -> LocatedYaml:
     """Read ``file`` safely; an unreadable file or bad syntax is an :class:`InputError`."""
     path = Path(file)
@@ -147,6 +175,7 @@ def load_yaml(file: str | Path) -> LocatedYaml:
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"cannot read file: {exc}", file=path) from None
     try:
+        _check_depth(text, path)
         root = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as exc:
         # An unclosed bracket or quote shows up lines later, often at the end of the file;

@@ -176,6 +176,15 @@ CASES = [
          marker="robot: uav9", key="timeline[0].robot", says=("no robot 'uav9'",)),
     Case("duplicate_team_ids", replace("{id: uav2,", "{id: uav1,"), marker="id: uav1", nth=2,
          alt_markers=("team:",), key="team", key_prefix=True, says=("uav1",)),
+    # issue 19: each was a traceback (RecursionError, OSError, ValueError) or numpy warnings
+    Case("nested_5000_deep", append("extra: " + "[" * 5000 + "]" * 5000 + "\n"),
+         marker="extra: [[[", key="extra", says=("nested more than 64 levels deep",)),
+    Case("name_of_a_million_characters", replace("name: urban_search", "name: " + "a" * 1_000_000),
+         marker="name: aaa", key="name", says=("at most 200 characters", "1,000,000 characters")),
+    Case("negative_seed", replace("seed: 42", "seed: -1"), marker="seed: -1", key="seed",
+         says=("greater than or equal to 0",)),
+    Case("coordinate_1e308", replace("start: [90, 60, 0]", "start: [1e308, 60, 0]"),
+         marker="start: [1e308", key="team[0].start[0]", says=("less than or equal to",)),
 ]
 
 

@@ -6,14 +6,16 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-# Every number is finite: no .inf time limits, no .nan positions.
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+# Every number is finite: no .inf time limits, no .nan positions; and no coordinate beyond
+# what any site holds (1,000 km), so arithmetic on it cannot overflow.
+Finite = Annotated[float, Field(allow_inf_nan=False, ge=-1e6, le=1e6)]
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegativeFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 Vec3 = tuple[Finite, Finite, Finite]
 Kind = Literal["uav", "ugv", "human"]
 Unit = Annotated[float, Field(ge=0.0, le=1.0)]
 Sound = Literal["minimal", "moderate", "loud"]
+NAME_MAX = 200  # characters of a name that becomes a folder (file systems allow 255 bytes)
 
 
 class Strict(BaseModel):
@@ -308,9 +310,10 @@ class OutputsSpec(Strict):
 
 
 class MissionSpec(Strict):
-    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
+    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$", max_length=NAME_MAX,
+                      description="also the output folder's name (out/NAME)")
     world: str = Field(description="world file, relative to the mission file")
-    seed: int = 0
+    seed: int = Field(0, ge=0, description="every random draw derives from it")
     fidelity: Literal["kinematic", "physics"] = "kinematic"
     time_limit: PositiveFloat = 3600.0
     team: list[MemberSpec] = Field(min_length=1)

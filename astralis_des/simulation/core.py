@@ -16,6 +16,7 @@ from astralis_des.actions import ACTIONS
 from astralis_des.actions.common import MotionFailed
 from astralis_des.assignment import Agent, Assignment, RoomInfo, Weights, assign
 from astralis_des.cosim import load_fidelity
+from astralis_des.exits import deferred_interrupts
 from astralis_des.kernel.contracts import PluginSensor
 from astralis_des.kernel.events import EventLog
 from astralis_des.kernel.handler import TaskHandler
@@ -230,8 +231,8 @@ class Simulation:
     # -- running ---------------------------------------------------------------------------
     def run(self) -> RunResult:
         """Run until the target is found, the rooms run out or the time limit; then write."""
-        self.start()
-        try:
+        try:  # an interrupt while starting still ends the outputs with mission_end
+            self.start()
             self.advance()
         finally:
             result = self.finish()
@@ -241,6 +242,10 @@ class Simulation:
         """Open the outputs and start the timeline; ``advance`` then moves time on."""
         if self._end is not None:
             return
+        with deferred_interrupts():  # the outputs open whole, and say the mission started
+            self._open()
+
+    def _open(self) -> None:
         spec = self.mission.spec
         self._wall0 = time.perf_counter()
         self._sinks = OUTPUTS.get("files")(self, self.out_dir)

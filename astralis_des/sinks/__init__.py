@@ -16,6 +16,9 @@ if TYPE_CHECKING:
     from astralis_des.simulation.result import RunResult
 
 
+OUTPUT_FILES = ("events.jsonl", "summary.json", "recording.rrd")
+
+
 class Output(Protocol):
     def on_event(self, record: Record) -> None: ...
     def close(self, result: RunResult) -> None: ...
@@ -86,6 +89,8 @@ def open_sinks(sim: Simulation, out_dir: Path | None) -> Outputs:
     if out_dir is not None:
         cfg = sim.mission.spec.outputs
         out_dir.mkdir(parents=True, exist_ok=True)
+        for name in OUTPUT_FILES:  # an earlier run's files never sit beside this run's
+            (out_dir / name).unlink(missing_ok=True)
         if cfg.events:
             outputs.append(JsonlWriter(out_dir / "events.jsonl"))
         if cfg.summary:

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 from astralis_des.errors import InputError
+from astralis_des.exits import default_termination
 from astralis_des.registry import Registry, UnknownEntry
 from astralis_des.studies.scenarios import ChunkResult, run_chunk
 
@@ -46,6 +47,7 @@ _STUDY: Study | None = None  # the study a pool worker runs, set once by its ini
 def _take_study(study: Study) -> None:
     global _STUDY
     _STUDY = study
+    default_termination()  # the pool ends its workers with SIGTERM: no interrupt there
 
 
 def _chunk_in_worker(job: tuple[list[int], Path | None]) -> ChunkResult:

@@ -39,8 +39,12 @@ def study_command(args: argparse.Namespace) -> int:
         result = _with_progress(console, study, lambda progress: run_study(
             study, workers=args.workers, backend=args.backend, address=args.address, out=out,
             recordings=True if args.recordings else None, progress=progress))
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # before the first scenario was under way
         console.print("[yellow]interrupted[/]; nothing written")
+        return EXIT_INTERRUPTED
+    if result.interrupted:
+        console.print(f"[yellow]interrupted[/]; the {len(result.rows):,} rows of the scenarios "
+                      f"done are in {out}/")
         return EXIT_INTERRUPTED
     if not args.quiet:
         stdout = Console()

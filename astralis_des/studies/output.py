@@ -77,6 +77,7 @@ def fill_folder(result: StudyResult, folder: Path) -> None:
     meta = {"astralis_des": __version__, "study": study.name, "seed": study.spec.seed,
             "scenarios": study.scenarios, "variants": [v.name for v in study.variants],
             "evaluate": study.spec.evaluate, "rows": len(result.rows), "failed": result.failed,
+            "interrupted": result.interrupted,
             "backend": result.backend, "workers": result.workers,
             "wall_time_s": round(result.wall_time, 3), "python": platform.python_version(),
             "mission": str(study.mission.path) if study.mission.path else None}

@@ -30,6 +30,7 @@ class StudyResult:
     wall_time: float = 0.0
     backend: str = "local"
     workers: int = 1
+    interrupted: bool = False  # Ctrl-C, SIGTERM or SIGHUP: the rows of the scenarios done
 
     @cached_property
     def table(self) -> pa.Table:

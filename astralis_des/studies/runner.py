@@ -35,7 +35,9 @@ def run_study(study: Study, *, workers: int | None = None, backend: str = "local
     ``workers``: processes (default: the CPUs); ``backend``: ``local`` (a process pool) or
     ``ray`` (``address`` for an existing cluster, else a local instance). With ``out``, the
     study folder is written there, all or nothing; ``recordings`` (default: the study file's
-    ``outputs.recordings``) writes each mission's outputs under it.
+    ``outputs.recordings``) writes each mission's outputs under it. Interrupted (Ctrl-C,
+    SIGTERM, SIGHUP), it returns, and writes, the rows of the scenarios done, with
+    ``interrupted`` set.
     """
     workers = workers or os.cpu_count() or 1
     runner = make_backend(backend, workers, address)
@@ -51,17 +53,21 @@ def run_study(study: Study, *, workers: int | None = None, backend: str = "local
         failures: list[str] = []
         done = 0
         parts = runner.run(study, chunks(study.scenarios, runner.workers), rec_dir)
+        interrupted = False
         with closing(parts):  # an interrupted run stops its workers at once
-            for part in parts:
-                rows += part.rows
-                failures += part.failures
-                done += part.scenarios
-                if progress is not None:
-                    progress(done, study.scenarios)
+            try:
+                for part in parts:
+                    rows += part.rows
+                    failures += part.failures
+                    done += part.scenarios
+                    if progress is not None:
+                        progress(done, study.scenarios)
+            except KeyboardInterrupt:  # keep the scenarios done
+                interrupted = True
         order = {v.name: v.index for v in study.variants}
         rows.sort(key=lambda r: (r["scenario"], order[r["variant"]]))
         result = StudyResult(study, rows, failures, time.perf_counter() - t0, backend,
-                             runner.workers)
+                             runner.workers, interrupted)
         if tmp is not None:
             fill_folder(result, tmp)
     return result

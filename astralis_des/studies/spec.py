@@ -23,7 +23,7 @@ from pydantic import Field, field_validator
 
 from astralis_des.errors import InputError, suggest
 from astralis_des.mission.loader import Mission, load_mission
-from astralis_des.mission.spec import Strict
+from astralis_des.mission.spec import NAME_MAX, Strict
 from astralis_des.registry import UnknownEntry
 from astralis_des.studies.draws import FromMission, Positions, Sampler, Scenario, draw_scenario
 from astralis_des.studies.factors import FACTORS, Setting, base_setting, label
@@ -55,7 +55,7 @@ class StudyOutputs(Strict):
 
 
 class StudySpec(Strict):
-    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$")
+    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$", max_length=NAME_MAX)
     mission: str = Field(description="the base mission file, relative to the study file")
     seed: int = 0
     scenarios: int = Field(description="random scenarios, each run under every variant")
