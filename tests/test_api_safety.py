@@ -301,3 +301,19 @@ def test_serve_answers_and_ctrl_c_keeps_what_was_recorded(tmp_path: Path) -> Non
     lines = [json.loads(x) for x in (out / "events.jsonl").read_text().splitlines()]
     assert lines[-1]["kind"] == "mission_end" and lines[-1]["outcome"] == "interrupted"
     assert (out / "recording.rrd").stat().st_size > 0
+
+
+def test_a_50_mb_request_is_refused_at_once_not_left_to_time_out(server: Background) -> None:
+    """The client refuses a request over the protocol's 64 KiB with ``too_large`` at once (a
+    50 MB one used to be sent, dropped by ZeroMQ's hard limit, and waited for until the
+    client's time-out); the server still answers afterwards."""
+    from astralis_des.api.protocol import ApiError
+
+    with Client(server.address, timeout=20.0, retries=0) as client:
+        t0 = time.monotonic()
+        with pytest.raises(ApiError) as refused:
+            client.request("status", note="x" * 50_000_000)
+        assert refused.value.code == "too_large"
+        assert "50,000,0" in str(refused.value)
+        assert time.monotonic() - t0 < 5.0
+        assert client.robot("uav1")["type"] == "uav"

@@ -18,7 +18,7 @@ from typing import Any
 
 import zmq
 
-from astralis_des.api.protocol import DEFAULT_BIND, ApiError, ApiTimeout
+from astralis_des.api.protocol import DEFAULT_BIND, MAX_MESSAGE, ApiError, ApiTimeout
 from astralis_des.api.security import secure_client
 
 
@@ -49,6 +49,9 @@ class Client:
         ``timeout`` and ``retries`` override the client's for this request."""
         request_id = f"{self._prefix}-{next(self._ids)}"
         frame = json.dumps({"op": op, "id": request_id, **args}).encode()
+        if len(frame) > MAX_MESSAGE:  # the server would refuse it, or (over its hard limit)
+            raise ApiError("too_large", f"the request is {len(frame):,} bytes; the limit is "
+                           f"{MAX_MESSAGE:,}")  # drop the connection: not sent at all
         wait = self.timeout if timeout is None else timeout
         tries = 1 + (self.retries if retries is None else retries)
         for _ in range(tries):
