@@ -48,7 +48,10 @@ def deferred_interrupts() -> Iterator[None]:
         yield
         return
     caught: list[int] = []
-    names = [n for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    # only the signals that interrupt already (a handler in Python); one left to its default
+    # (a library user's process) keeps it
+    names = [n for n in ("SIGINT", "SIGTERM", "SIGHUP")
+             if hasattr(signal, n) and callable(signal.getsignal(getattr(signal, n)))]
     before = {n: signal.getsignal(getattr(signal, n)) for n in names}
     for name in names:
         signal.signal(getattr(signal, name), lambda signum, frame: caught.append(signum))
