@@ -162,21 +162,22 @@ class PhysicsCoSim:
         """Put the movers near a moving robot where they are at the end of the coming tick.
         Done at the contact checks' rate (30 Hz): a walker then jumps about 3 cm at a time;
         one far from every moving robot touches nothing and jumps when it comes near."""
-        reset, then = self.client.call, self.t + self.period
+        then = self.t + self.period
         self.movers_time = then
-        for index in self.local.near:
-            mover, body = self.movers[index]
-            reset("resetBasePositionAndOrientation", body, mover.position_at(then).tolist(),
-                  [0.0, 0.0, 0.0, 1.0])
+        self._put_movers([self.movers[index] for index in self.local.near], then)
 
     def _place_movers(self) -> None:
         """Every mover where it is now, as a robot sets off: a body not moved while no robot
         was near it stays where it was last simulated, and a robot setting off there would
         meet it (a UAV waiting where a patrolling avatar had stopped being moved was tipped
         over by it)."""
-        for mover, body in self.movers:
+        self._put_movers(self.movers, self.env.now)
+
+    def _put_movers(self, movers: list[tuple[Mover, int]], t: float) -> None:
+        """Each mover's body where its script has it at ``t``."""
+        for mover, body in movers:
             self.client.call("resetBasePositionAndOrientation", body,
-                             mover.position_at(self.env.now).tolist(), [0.0, 0.0, 0.0, 1.0])
+                             mover.position_at(t).tolist(), [0.0, 0.0, 0.0, 1.0])
 
     # -- the co-simulation contract ------------------------------------------------------
     def execute(self, robot: Robot, motion: Motion) -> simpy.Event:

@@ -331,11 +331,10 @@ class LocalLayer:
 
 
 def _lowest(me: Body, ahead: FloatArray) -> float:
-    """The bottom of a UAV's band as low as its course comes over its path ahead: coming down
-    from a lifted point (over furniture, or where it made way), it must not come down onto a
-    walker."""
-    low = float(ahead[:, 2].min()) + HEIGHTS["uav"][0] if len(ahead) else me.base_z[0]
-    return min(me.base_z[0], low)
+    """The bottom of a UAV's band where its course comes lowest over its path ahead (the
+    climb rule takes the lower of this and its band now): coming down from a lifted point
+    (over furniture, or where it made way), it must not come down onto a walker."""
+    return float(ahead[:, 2].min()) + HEIGHTS["uav"][0] if len(ahead) else me.base_z[0]
 
 
 def _round(path: FloatArray, xy: FloatArray, clear: float) -> FloatArray | None:
