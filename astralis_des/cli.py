@@ -74,6 +74,18 @@ def _parser() -> argparse.ArgumentParser:
                        "or its traceback if it fails")
     study.add_argument("--variant", help="with --replay: only this variant")
     study.add_argument("--quiet", action="store_true", help="no progress bar or report")
+    tune = sub.add_parser("tune", help="fit study parameters to target figures, or find the "
+                          "front of several objectives (Optuna); a folder of trials, the "
+                          "best or the front, plots and a report")
+    tune.add_argument("tune", help="tune YAML file")
+    tune.add_argument("--workers", type=_positive, help="processes (default: the CPUs)")
+    tune.add_argument("--backend", default="local", help="local (a process pool) or ray")
+    tune.add_argument("--address", help="ray: the address of an existing cluster")
+    tune.add_argument("--out", help="output folder (default out/<tune name>)")
+    tune.add_argument("--trials", type=_positive, help="override the tune's trials")
+    tune.add_argument("--resume", action="store_true",
+                      help="go on after the trials the output folder holds")
+    tune.add_argument("--quiet", action="store_true", help="no progress bar or report")
     from astralis_des.cli_api import API_COMMANDS, add_api_parsers
 
     add_api_parsers(sub, _add_mission_options)
@@ -239,6 +251,13 @@ def _study(args: argparse.Namespace) -> int:
     from astralis_des.studies.console import study_command
 
     return study_command(args)
+
+
+@command("tune")
+def _tune(args: argparse.Namespace) -> int:
+    from astralis_des.studies.tune_console import tune_command
+
+    return tune_command(args)
 
 
 @command("schema")

@@ -26,10 +26,7 @@ def validate(model: type[M], doc: LocatedYaml, *, context: dict[str, Any] | None
 
 def _to_input_error(model: type[BaseModel], doc: LocatedYaml, exc: ValidationError) -> InputError:
     error = _most_useful(exc.errors())
-    # a scalar union's member shows as its type ("tuple[...]"): the file has no such key
-    path: KeyPath = tuple(p for p in error["loc"] if isinstance(p, int)
-                          or (isinstance(p, str) and "[" not in p))
-    path = _drop_union_tags(model, path)
+    path = _drop_union_tags(model, _file_path(doc.data, error["loc"]))
     if error["type"] == "extra_forbidden":
         key = str(path[-1])
         owner = _model_at(model, path[:-1])
@@ -53,6 +50,24 @@ def _to_input_error(model: type[BaseModel], doc: LocatedYaml, exc: ValidationErr
         elif isinstance(value, str | int | float | bool):
             message += f" (got {value!r})"
     return doc.error(path, message)
+
+
+def _file_path(data: Any, loc: tuple[Any, ...]) -> KeyPath:
+    """The error's location without the type names pydantic puts in for a scalar union's
+    member (``tuple[float, float, float]``): parts the file has, or keys that are missing."""
+    path: list[str | int] = []
+    for part in loc:
+        present = isinstance(data, dict | list) and _has(data, part)
+        if present or isinstance(part, int) or "[" not in str(part):
+            path.append(part)
+        data = data[part] if present else None
+    return tuple(path)
+
+
+def _has(data: dict[Any, Any] | list[Any], part: Any) -> bool:
+    if isinstance(data, dict):
+        return part in data
+    return isinstance(part, int) and -len(data) <= part < len(data)
 
 
 def _most_useful(errors: list[Any]) -> Any:

@@ -173,7 +173,6 @@ def test_a_broken_sidecar_is_named_when_the_world_loads(tmp_path: Path) -> None:
                                          "not a readable .npz file"):
         load_world((tmp_path / "w" / "twin.yaml").resolve())
     (tmp_path / "w" / "twin.blocks.npz").unlink()
-    load_world.cache_clear()
     with pytest.raises(InputError, match=r"geometry\.blocks: no such file"):
         load_world((tmp_path / "w" / "twin.yaml").resolve())
 

@@ -25,7 +25,6 @@ RADIUS = 0.35  # a UAV's body and the planner's margin
 def write_world(tmp_path: Path, body: str) -> Path:
     path = tmp_path / "w.yaml"
     path.write_text("name: w\nsite: {size: [50, 40]}\n" + body, encoding="utf-8")
-    load_world.cache_clear()
     return path
 
 

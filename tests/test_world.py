@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from astralis_des.errors import InputError
+from astralis_des.world.build import load_world
 from astralis_des.world.model import World
 
 
@@ -103,3 +105,16 @@ def test_points_inside_walls_or_outside_the_site_are_refused(world: World) -> No
         world.router.place_of((-5.0, 10.0, 0.0))
     with pytest.raises(InputError, match="inside a building or obstacle"):
         world.router.place_of((78.0, 84.0, 1.0))  # the closed space beside the lobby
+
+
+def test_a_world_file_edited_between_two_loads_is_read_anew(tmp_path: Path) -> None:
+    # found by the fuzzer: worlds were cached by path, so a notebook or a server that loaded a
+    # world, then its edited file, kept the first one (a mission on it named the old buildings)
+    path = tmp_path / "w.yaml"
+    body = "name: w\nsite: {size: [60, 40]}\nbuildings:\n  - {id: %s, origin: [10, 10], " \
+           "floors: 1, segments: [{side: north, rooms: 1}]}\n"
+    path.write_text(body % "A", encoding="utf-8")
+    assert list(load_world(path).buildings) == ["A"]
+    path.write_text(body % "HQ", encoding="utf-8")
+    assert list(load_world(path).buildings) == ["HQ"]
+    assert load_world(path) is load_world(path)  # the same file is built once

@@ -36,6 +36,7 @@ class ApiError(Exception):
     """A request the server refused, or a failure the client saw: a code and one line."""
 
     def __init__(self, code: str, message: str) -> None:
+        message = " ".join(message.split())  # one line, whatever the request put in it
         super().__init__(message)
         self.code = code
         self.message = message

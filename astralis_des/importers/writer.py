@@ -45,9 +45,9 @@ def write_world(built: Built, source: Path, out: Path, name: str, command: str) 
 
 def _check(path: Path) -> None:
     """Load the new world as a mission would; a failure is a bug of the importer."""
-    from astralis_des.world.build import load_world
+    from astralis_des.world.build import read_world
 
-    load_world.__wrapped__(path.resolve())  # not cached: the path is a temporary one
+    read_world(path.resolve())  # not cached: the path is a temporary one
 
 
 def _sidecars(built: Built, folder: Path, stem: str) -> dict[str, object]:

@@ -6,6 +6,7 @@ segments of rooms on its north and south sides, a lobby at the east end with the
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -63,9 +64,23 @@ def _road_box(start: tuple[float, float], end: tuple[float, float], width: float
     return Box((lo[0] - pad_x, lo[1] - pad_y, 0.0), (hi[0] + pad_x, hi[1] + pad_y, 0.02))
 
 
-@lru_cache(maxsize=16)
 def load_world(path: Path) -> World:
-    """Read, validate and build a world file; cached, since a world never changes."""
+    """Read, validate and build a world file. Built once for each content of the file: a
+    file edited between two loads in one process (a notebook, a server) is read anew."""
+    try:
+        digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError:
+        digest = ""  # load_yaml says what is wrong with the path
+    return _built(Path(path), digest)
+
+
+@lru_cache(maxsize=16)
+def _built(path: Path, _digest: str) -> World:
+    return read_world(path)
+
+
+def read_world(path: Path) -> World:
+    """Read, validate and build a world file, every time (:func:`load_world` builds once)."""
     from astralis_des.validation import check_unique_ids, validate
     from astralis_des.yamlio import load_yaml
 

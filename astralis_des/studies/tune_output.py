@@ -1,0 +1,143 @@
+"""A tune's folder: the trials table (CSV, Parquet), the best trial or the front (JSON), plots
+of each aim against each parameter and of the front, a report, the tune file and its meta.
+
+The journal (``trials.jsonl``) is written as trials end; these files are written (each
+atomically) when the tune ends or is interrupted.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import platform
+from pathlib import Path
+from typing import Any
+
+from astralis_des.studies.table import Z95, write_table
+from astralis_des.studies.tune import JOURNAL, TuneResult
+
+TUNE_FILES = (JOURNAL, "trials.csv", "trials.parquet", "best.json", "report.md", "tune.yaml",
+              "meta.json", "plots")
+
+
+def write_tune(result: TuneResult, folder: Path) -> None:
+    import pyarrow as pa
+
+    from astralis_des.version import __version__
+
+    folder.mkdir(parents=True, exist_ok=True)
+    if result.rows:
+        columns = list(dict.fromkeys(["trial", *(k for r in result.rows for k in r)]))
+        table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in result.rows])
+        write_table(table, folder, "trials")
+    _atomic(folder / "best.json", json.dumps(result.best, indent=2) + "\n")
+    _atomic(folder / "report.md", "\n".join(report(result)) + "\n")
+    _atomic(folder / "tune.yaml", result.tune.text)
+    meta = {"astralis_des": __version__, "tune": result.tune.name, "seed": result.tune.spec.seed,
+            "sampler": result.tune.spec.sampler, "trials": len(result.rows),
+            "trials_asked": result.tune.spec.trials, "interrupted": result.interrupted,
+            "scenarios": result.tune.study.scenarios, "wall_time_s": round(result.wall_time, 3),
+            "python": platform.python_version()}
+    _atomic(folder / "meta.json", json.dumps(meta, indent=2) + "\n")
+    if result.rows:
+        write_plots(result, folder / "plots")
+
+
+def _atomic(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    tmp.replace(path)
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, float):
+        return "inf" if math.isinf(value) else f"{value:.4g}"
+    return str(value)
+
+
+def report(result: TuneResult) -> list[str]:
+    """The report's lines (Markdown): what was searched, the best (or the front), the fit."""
+    spec = result.tune.spec
+    params = list(spec.params)
+    ok = [r for r in result.rows if r["state"] == "ok"]
+    lines = [f"# Tune {spec.name}", "",
+             f"{len(result.rows)} of {spec.trials} trials ({spec.sampler}, seed {spec.seed}), "
+             f"{result.tune.study.scenarios:,} scenarios a trial"
+             + ("; interrupted" if result.interrupted else "") + ".", ""]
+    if not result.best:
+        return [*lines, "No trial ran to the end."]
+    if spec.targets:
+        best = result.best[0]
+        lines += ["## Best trial", "", f"Trial {best['trial']}: largest |z| "
+                  f"{_fmt(best['score'])}.", "",
+                  "| parameter | value |", "| --- | --- |",
+                  *(f"| {p} | {_fmt(best[f'param.{p}'])} |" for p in params), "",
+                  "| target | ours | wanted | z |", "| --- | --- | --- | --- |",
+                  *(f"| {m} | {_fmt(best[m])} | {_fmt(t.value)} | {best[f'z.{m}']:+.2f} |"
+                    for m, t in result.tune.targets().items()), ""]
+        fits = result.fits()
+        lines += ["## The weights that fit", "",
+                  f"{len(fits)} of {len(ok)} trials reproduce every target within sampling "
+                  f"error (|z| <= {Z95:.2f}) and meet the constraints."]
+        if fits:
+            lines += ["Over them, each parameter ranges:", "", "| parameter | min | max |",
+                      "| --- | --- | --- |"]
+            for p in params:
+                values = [r[f"param.{p}"] for r in fits]
+                if all(isinstance(v, int | float) for v in values):
+                    lines.append(f"| {p} | {_fmt(min(values))} | {_fmt(max(values))} |")
+                else:
+                    lines.append(f"| {p} | {', '.join(sorted(set(map(str, values))))} | |")
+        return lines
+    aims = [o.metric for o in spec.objectives]
+    lines += ["## Front" if len(aims) > 1 else "## Best trial", "",
+              "| trial | " + " | ".join([*params, *aims]) + " |",
+              "| --- " * (1 + len(params) + len(aims)) + "|"]
+    lines += [f"| {r['trial']} | " + " | ".join(_fmt(r[k]) for k in
+                                                [*(f"param.{p}" for p in params), *aims]) + " |"
+              for r in result.best]
+    return lines
+
+
+def write_plots(result: TuneResult, folder: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    folder.mkdir(parents=True, exist_ok=True)
+    spec = result.tune.spec
+    ok = [r for r in result.rows if r["state"] == "ok"]
+    aims = (["score"] if spec.targets else [o.metric for o in spec.objectives])
+    params = list(spec.params)
+    fig, axes = plt.subplots(len(aims), len(params), squeeze=False,
+                             figsize=(3.2 * len(params), 2.6 * len(aims)))
+    for i, aim in enumerate(aims):
+        for j, p in enumerate(params):
+            ax = axes[i][j]
+            xs = [r[f"param.{p}"] for r in ok]
+            ys = [min(r[aim], 1e6) for r in ok]
+            colours = ["tab:green" if r["feasible"] else "tab:red" for r in ok]
+            ax.scatter([str(x) if isinstance(x, str) else x for x in xs], ys, s=12, c=colours)
+            ax.set_xlabel(p)
+            if j == 0:
+                ax.set_ylabel("largest |z|" if aim == "score" else aim)
+            if aim == "score":
+                ax.axhline(Z95, color="grey", lw=0.8, ls="--")
+    fig.suptitle(f"{spec.name}: each trial (red: a constraint not met)")
+    fig.tight_layout()
+    fig.savefig(folder / "params.png", dpi=110)
+    plt.close(fig)
+    if len(aims) == 2:
+        fig, ax = plt.subplots(figsize=(5, 4))
+        ax.scatter([r[aims[0]] for r in ok], [r[aims[1]] for r in ok], s=12, c="lightgrey",
+                   label="trials")
+        front = sorted(result.best, key=lambda r: r[aims[0]])
+        ax.plot([r[aims[0]] for r in front], [r[aims[1]] for r in front], "o-",
+                color="tab:blue", label="front")
+        ax.set_xlabel(aims[0])
+        ax.set_ylabel(aims[1])
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(folder / "front.png", dpi=110)
+        plt.close(fig)
