@@ -29,6 +29,21 @@ class LocatedYaml:
             path = path[:-1]
         return self.lines.get((), None)
 
+    def file_at(self, path: KeyPath, name: str, what: str = "file") -> Path:
+        """The existing file that key ``path`` names (``name``, relative to this file's folder);
+        else an error at that key, also for a name no file system takes (too long, a NUL)."""
+        shown = name if len(name) <= 120 else f"{name[:60]}... ({len(name):,} characters)"
+        try:
+            where = (self.file.parent / name).resolve()
+            found = where.is_file()
+        except (OSError, ValueError) as exc:  # ENAMETOOLONG; "embedded null byte"
+            reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+            raise self.error(path, f"cannot use '{shown}' as a {what}: {reason}") from None
+        if not found:
+            raise self.error(path, f"no such {what}: "
+                             f"{where if len(str(where)) <= 300 else shown}")
+        return where
+
     def error(self, path: KeyPath, message: str) -> InputError:
         return InputError(message, file=self.file, line=self.line_of(path),
                           key=format_path(path) or None)

@@ -50,7 +50,7 @@ def test_variants_cross_the_varied_values(tmp_path: Path) -> None:
     last = study.variants[3]
     assert last.columns == {"strategy": "mixed", "w1.human": 10.0}
     assert (last.setting.strategy, last.setting.weights["risk"]) == (
-        "mixed", {"human": 10.0, "uav": 5.0, "ugv": 0.0})
+        "mixed", {"human": 10.0, "uav": 5.0, "ugv": 3.0})
 
 
 def test_named_values_and_set(tmp_path: Path) -> None:

@@ -53,21 +53,32 @@ def test_mixed_never_sends_the_human_into_high_risk(small: dict[tuple[str, str],
     assert small[("mixed", "human_high_risk")] == 0.0
 
 
-def test_mixed_ugv_figure_is_above_the_papers(small: dict[tuple[str, str], float]) -> None:
-    """With W1 read in reverse, the UGV goes to a high-messiness room in about 12.7% of
-    scenarios, not the paper's 5.9% (docs/studies.md): within our own sampling error of
-    12.7%, outside that of 5.9%."""
+def test_mixed_ugv_figure_is_the_papers_with_the_default_weights(
+        small: dict[tuple[str, str], float]) -> None:
+    """With the default weights (W1 reversed, the UGV's risk weight 3: issue 20's fit), the
+    UGV goes to a high-messiness room within sampling error of the paper's 5.9%."""
     ugv = small[("mixed", "ugv_high_mess")]
+    assert abs(ugv - 0.059) <= tolerance(0.059, N)
+
+
+def test_w1_reversed_alone_sends_the_ugv_into_clutter_twice_as_often() -> None:
+    """The printed numbers with W1 read in reverse (UGV risk weight 0) give about 12.7%, not
+    5.9% (docs/studies.md): within our own sampling error of 12.7%, outside that of 5.9%."""
+    study = load_study(TABLE5).with_changes(
+        scenarios=N, vary={"strategy": ["mixed"],
+                           "weights": {"w1_reversed": READINGS["w1_reversed"]}})
+    ugv = shares(run_study(study, workers=1))[
+        ("strategy=mixed,weights=w1_reversed", "ugv_high_mess")]
     assert abs(ugv - 0.127) <= tolerance(0.127, N)
     assert abs(ugv - 0.059) > tolerance(0.059, N)
 
 
 def test_unassigned_agents_under_mixed(small: dict[tuple[str, str], float]) -> None:
     """Under mixed, the agent left out is the human or the UGV (the paper's text), about
-    nine times in ten the human; a UAV almost never."""
+    four times in five the human; a UAV almost never."""
     human, uav, ugv = (small[("mixed", f"{k}_unassigned")] for k in ("human", "uav", "ugv"))
     assert human + uav + ugv == pytest.approx(1.0)  # one agent left out of 4 for 3 rooms
-    assert abs(human - 0.90) <= tolerance(0.90, N)
+    assert abs(human - 0.79) <= tolerance(0.79, N)
     assert uav <= 0.01
 
 
@@ -75,9 +86,9 @@ def test_shipped_study_gives_the_documented_figures(full: StudyResult) -> None:
     """docs/studies.md quotes these figures of ``astralis study studies/table5.yaml``."""
     got = {k: round(v * 1000) for k, v in shares(full).items()}
     assert (got[("naive", "human_high_risk")], got[("naive", "ugv_high_mess")]) == (380, 377)
-    assert (got[("mixed", "human_high_risk")], got[("mixed", "ugv_high_mess")]) == (0, 127)
+    assert (got[("mixed", "human_high_risk")], got[("mixed", "ugv_high_mess")]) == (0, 60)
     assert [got[("naive", f"{k}_unassigned")] for k in ("human", "uav", "ugv")] == [226, 533, 241]
-    assert [got[("mixed", f"{k}_unassigned")] for k in ("human", "uav", "ugv")] == [899, 2, 99]
+    assert [got[("mixed", f"{k}_unassigned")] for k in ("human", "uav", "ugv")] == [792, 0, 208]
 
 
 def test_report_compares_with_the_paper(full: StudyResult) -> None:
@@ -85,8 +96,8 @@ def test_report_compares_with_the_paper(full: StudyResult) -> None:
     rows = table5_report(full)[0].rows
     assert rows[0] == ["Human assigned to high-risk area", "naive", "38.0% [35.0, 41.0]",
                        "39.3%", "yes (z = -0.60)"]
-    assert rows[3] == ["UGV assigned to high-messiness area", "mixed", "12.7% [10.8, 14.9]",
-                       "5.9%", "NO (z = +5.24)"]
+    assert rows[3] == ["UGV assigned to high-messiness area", "mixed", "6.0% [4.7, 7.6]",
+                       "5.9%", "yes (z = +0.09)"]
     assert [c["strategy"] for c in compare(full)] == ["naive", "naive", "mixed", "mixed"]
 
 

@@ -126,3 +126,9 @@ def test_bad_tune_files_are_one_line_and_write_nothing(
     assert len(err.splitlines()) == 1
     assert re.search(message, err), err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "tunes").glob("*.yaml")), ids=lambda p: p.stem)
+def test_each_tune_file_of_the_repository_loads(path: Path) -> None:
+    tune = load_tune(path)
+    assert tune.metrics() and tune.spec.trials >= 1

@@ -59,17 +59,12 @@ def load_mission(path: str | Path) -> Mission:
     """Read a mission file; any problem is an :class:`InputError` naming file, line and key."""
     doc = load_yaml(path)
     spec = _validate(doc)
-    world_path = (doc.file.parent / spec.world).resolve()
-    if not world_path.is_file():
-        raise doc.error(("world",), f"no such world file: {world_path}")
-    world = load_world(world_path)
+    world = load_world(doc.file_at(("world",), spec.world, "world file"))
     _check_references(spec, world, doc)
     catalogue = None
     if spec.scene.catalogue is not None:
-        where = (doc.file.parent / spec.scene.catalogue).resolve()
-        if not where.is_file():
-            raise doc.error(("scene", "catalogue"), f"no such catalogue file: {where}")
-        catalogue = load_catalogue(where)
+        catalogue = load_catalogue(doc.file_at(("scene", "catalogue"), spec.scene.catalogue,
+                                               "catalogue file"))
     return Mission(spec, world, doc.file, catalogue)
 
 

@@ -132,9 +132,7 @@ def load_study(path: str | Path) -> Study:
     """Read a study file and its base mission; a problem names the file, line and key."""
     doc = load_yaml(path)
     spec = validate(StudySpec, doc)
-    mission_path = (doc.file.parent / spec.mission).resolve()
-    if not mission_path.is_file():
-        raise doc.error(("mission",), f"no such mission file: {mission_path}")
+    mission_path = doc.file_at(("mission",), spec.mission, "mission file")
     text = doc.file.read_text(encoding="utf-8")
     return _build(spec, load_mission(mission_path), doc, text)
 

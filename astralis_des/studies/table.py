@@ -33,6 +33,17 @@ def write_table(table: pa.Table, folder: Path, stem: str = "table") -> None:
     pq.write_table(table, folder / f"{stem}.parquet")
 
 
+def two_proportion_z(share: float, n: int, other: float, other_n: int) -> float:
+    """Two-proportion z-test (pooled): ``share`` of ``n`` against ``other`` of ``other_n``;
+    0 when both are exact and equal."""
+    pooled = (share * n + other * other_n) / (n + other_n)
+    se = math.sqrt(pooled * (1 - pooled) * (1 / n + 1 / other_n))
+    diff = share - other
+    if se == 0:
+        return 0.0 if diff == 0 else math.copysign(math.inf, diff)
+    return diff / se
+
+
 def wilson(k: int, n: int, z: float = Z95) -> tuple[float, float, float]:
     """A proportion ``k / n`` and its Wilson score interval (sound at 0 and 1)."""
     if n == 0:

@@ -8,11 +8,10 @@ counting the paper's own 1,000 scenarios as a sample too.
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, Any
 
 from astralis_des.studies.reports import REPORTS, TextTable, summary_report
-from astralis_des.studies.table import Z95, format_estimate
+from astralis_des.studies.table import Z95, format_estimate, two_proportion_z
 
 if TYPE_CHECKING:
     from astralis_des.studies.results import StudyResult
@@ -41,10 +40,7 @@ READINGS: dict[str, dict[str, dict[str, float]]] = {
 
 def z_score(k: int, n: int, paper: float, paper_n: int = PAPER_N) -> float:
     """Two-proportion z: our ``k / n`` against the paper's share of ``paper_n`` scenarios."""
-    pooled = (k + paper * paper_n) / (n + paper_n)
-    se = math.sqrt(pooled * (1 - pooled) * (1 / n + 1 / paper_n))
-    diff = k / n - paper
-    return 0.0 if se == 0 and diff == 0 else (math.inf if se == 0 else diff / se)
+    return two_proportion_z(k / n, n, paper, paper_n)
 
 
 def agrees(k: int, n: int, paper: float, z: float = Z95) -> bool:

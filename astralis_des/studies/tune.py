@@ -22,7 +22,7 @@ from typing import Any
 
 from astralis_des.errors import InputError
 from astralis_des.studies.runner import run_study
-from astralis_des.studies.table import Z95
+from astralis_des.studies.table import Z95, two_proportion_z
 from astralis_des.studies.tune_spec import Bound, Tune, split_metric
 
 JOURNAL = "trials.jsonl"
@@ -128,8 +128,9 @@ def evaluate(tune: Tune, params: dict[str, Any], workers: int | None, backend: s
     constraints = []
     for c in tune.spec.constraints:
         est = row[c.metric]
-        constraints.append(max((c.min - est) if c.min is not None else -math.inf,
-                               (est - c.max) if c.max is not None else -math.inf))
+        excess = max((c.min - est) if c.min is not None else -math.inf,
+                     (est - c.max) if c.max is not None else -math.inf)
+        constraints.append(excess if not math.isnan(excess) else math.inf)  # no value: broken
     values = ([max(z_all)] if tune.spec.targets
               else [row[o.metric] for o in tune.spec.objectives])
     failed = result.failed
@@ -147,10 +148,8 @@ def z_score(entry: dict[str, Any], target: float, n_target: int) -> float:
     if not n or math.isnan(est):
         return math.inf
     if entry["kind"] == "rate":
-        pooled = (est * n + target * n_target) / (n + n_target)
-        se = math.sqrt(pooled * (1 - pooled) * (1 / n + 1 / n_target))
-    else:
-        se = (entry["high"] - entry["low"]) / (2 * Z95) if math.isfinite(entry["high"]) else 0
+        return two_proportion_z(est, n, target, n_target)
+    se = (entry["high"] - entry["low"]) / (2 * Z95) if math.isfinite(entry["high"]) else 0
     if se == 0:
         return 0.0 if est == target else math.copysign(math.inf, est - target)
     return (est - target) / se

@@ -110,19 +110,24 @@ def write_plots(result: TuneResult, folder: Path) -> None:
     ok = [r for r in result.rows if r["state"] == "ok"]
     aims = (["score"] if spec.targets else [o.metric for o in spec.objectives])
     params = list(spec.params)
-    fig, axes = plt.subplots(len(aims), len(params), squeeze=False,
-                             figsize=(3.2 * len(params), 2.6 * len(aims)))
+    cols = min(3, len(params))
+    rows_per_aim = -(-len(params) // cols)
+    fig, axes = plt.subplots(len(aims) * rows_per_aim, cols, squeeze=False,
+                             figsize=(3.6 * cols, 2.8 * len(aims) * rows_per_aim))
+    for ax in axes.flat[len(aims) * len(params):]:
+        ax.set_visible(False)
     for i, aim in enumerate(aims):
         for j, p in enumerate(params):
-            ax = axes[i][j]
+            ax = axes[i * rows_per_aim + j // cols][j % cols]
             xs = [r[f"param.{p}"] for r in ok]
-            ys = [min(r[aim], 1e6) for r in ok]
+            ys = [min(max(r[aim], 0.05), 1e6) if aim == "score" else r[aim] for r in ok]
             colours = ["tab:green" if r["feasible"] else "tab:red" for r in ok]
             ax.scatter([str(x) if isinstance(x, str) else x for x in xs], ys, s=12, c=colours)
             ax.set_xlabel(p)
-            if j == 0:
+            if j % cols == 0:
                 ax.set_ylabel("largest |z|" if aim == "score" else aim)
             if aim == "score":
+                ax.set_yscale("log")  # |z| from 0.05 (below: drawn at 0.05)
                 ax.axhline(Z95, color="grey", lw=0.8, ls="--")
     fig.suptitle(f"{spec.name}: each trial (red: a constraint not met)")
     fig.tight_layout()

@@ -127,10 +127,7 @@ def load_tune(path: str | Path) -> Tune:
     """Read a tune file and its study; a problem names the file, line and key."""
     doc = load_yaml(path)
     spec = validate(TuneSpec, doc)
-    study_path = (doc.file.parent / spec.study).resolve()
-    if not study_path.is_file():
-        raise doc.error(("study",), f"no such study file: {study_path}")
-    study = load_study(study_path)
+    study = load_study(doc.file_at(("study",), spec.study, "study file"))
     if spec.scenarios is not None:
         study = study.with_changes(scenarios=spec.scenarios)
     tune = Tune(spec, study, doc.file.read_text(encoding="utf-8"), doc.file)

@@ -84,10 +84,10 @@ def load_geometry(spec: GeometrySpec, source: SourceSpec | None,
                   doc: LocatedYaml) -> tuple[list[Solid], Imported]:
     """Read the files beside the world file; a missing or broken one is an InputError that
     names it and the key that refers to it."""
-    folder = doc.file.parent
     blocks: list[Solid] = []
     if spec.blocks is not None:
-        arrays = _npz(folder / spec.blocks, doc, "blocks", ("boxes", "voxel"))
+        arrays = _npz(doc.file_at(("geometry", "blocks"), spec.blocks), doc, "blocks",
+                      ("boxes", "voxel"))
         voxel = float(arrays["voxel"])
         if abs(voxel - spec.voxel) > 1e-9:
             raise doc.error(("geometry", "voxel"), f"{spec.voxel:g} m, but {spec.blocks} holds "
@@ -95,25 +95,22 @@ def load_geometry(spec: GeometrySpec, source: SourceSpec | None,
         corners = np.asarray(arrays["boxes"], dtype=float).reshape(-1, 6) * voxel
         blocks = [Solid(BLOCK, Box(tuple(c[:3]), tuple(c[3:])), BLOCK) for c in corners.tolist()]
     vertices = faces = None
-    mesh_file = folder / spec.mesh if spec.mesh is not None else None
+    mesh_file = doc.file_at(("geometry", "mesh"), spec.mesh) if spec.mesh is not None else None
     if mesh_file is not None:
         vertices, faces = _mesh(mesh_file, doc)
     cloud = colors = None
     if spec.cloud is not None:
-        arrays = _npz(folder / spec.cloud, doc, "cloud", ("points", "colors"))
+        arrays = _npz(doc.file_at(("geometry", "cloud"), spec.cloud), doc, "cloud",
+                      ("points", "colors"))
         cloud = np.asarray(arrays["points"], dtype=float).reshape(-1, 3)
         colors = np.asarray(arrays["colors"], dtype=np.uint8).reshape(-1, 3)
-    parts = folder / spec.parts if spec.parts is not None else None
-    if parts is not None and not parts.is_file():
-        raise doc.error(("geometry", "parts"), f"no such file: {parts}")
+    parts = doc.file_at(("geometry", "parts"), spec.parts) if spec.parts is not None else None
     info = source.model_dump() if source is not None else {}
     return blocks, Imported(spec.voxel, spec.collision, info, tuple(spec.floors), mesh_file,
                             parts, vertices, faces, cloud, colors)
 
 
 def _npz(path: Path, doc: LocatedYaml, key: str, names: tuple[str, ...]) -> dict[str, Any]:
-    if not path.is_file():
-        raise doc.error(("geometry", key), f"no such file: {path}")
     try:
         with np.load(path, allow_pickle=False) as data:
             missing = [n for n in names if n not in data.files]
@@ -131,8 +128,6 @@ def _npz(path: Path, doc: LocatedYaml, key: str, names: tuple[str, ...]) -> dict
 def _mesh(path: Path, doc: LocatedYaml) -> tuple[FloatArray, NDArray[np.int64]]:
     import trimesh
 
-    if not path.is_file():
-        raise doc.error(("geometry", "mesh"), f"no such file: {path}")
     try:
         mesh: Any = trimesh.load(path, force="mesh", process=False)
     except Exception as exc:  # trimesh raises many kinds for a bad file
