@@ -99,6 +99,7 @@ def test_report_compares_with_the_paper(full: StudyResult) -> None:
     assert rows[3] == ["UGV assigned to high-messiness area", "mixed", "6.0% [4.7, 7.6]",
                        "5.9%", "yes (z = +0.09)"]
     assert [c["strategy"] for c in compare(full)] == ["naive", "naive", "mixed", "mixed"]
+    assert [row[4].split()[0] for row in rows[:4]] == ["yes"] * 4  # all four, default weights
 
 
 def test_weights_as_printed_send_the_human_into_high_risk() -> None:

@@ -77,6 +77,23 @@ def test_the_same_seed_gives_the_same_trials_and_a_resumed_tune_goes_on_as_one(
     assert "## The weights that fit" in (tmp_path / "c" / "report.md").read_text()
 
 
+def test_ctrl_c_keeps_the_trials_done(tmp_path: Path) -> None:
+    path = write(tmp_path, {"seed": 1, "trials": 10, "sampler": "random",
+                            "params": {"w1.ugv": {"low": 0, "high": 10}},
+                            "targets": {"mixed.ugv_high_mess": 0.06}})
+
+    def interrupt_after_two(done: int, _total: int) -> None:
+        if done == 2:
+            raise KeyboardInterrupt  # as Ctrl-C (or SIGTERM, made one) would, between trials
+
+    result = run_tune(load_tune(path), workers=1, out=tmp_path / "out",
+                      progress=interrupt_after_two)
+    assert result.interrupted and len(result.rows) == 2
+    meta = json.loads((tmp_path / "out" / "meta.json").read_text())
+    assert (meta["trials"], meta["interrupted"]) == (2, True)
+    assert len((tmp_path / "out" / "trials.csv").read_text().splitlines()) == 3  # header + 2
+
+
 def test_two_objectives_give_a_front_and_a_constraint_holds_on_it(tmp_path: Path) -> None:
     path = write(tmp_path, {"seed": 2, "trials": 12, "sampler": "nsga2",
                             "params": {"w1.ugv": {"low": 0, "high": 10},

@@ -16,36 +16,16 @@ import json
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from astralis_des.errors import InputError
 from astralis_des.studies.runner import run_study
 from astralis_des.studies.table import Z95, two_proportion_z
+from astralis_des.studies.tune_output import JOURNAL, TUNE_FILES, TuneResult, write_tune
 from astralis_des.studies.tune_spec import Bound, Tune, split_metric
 
-JOURNAL = "trials.jsonl"
 Progress = Callable[[int, int], None]  # (trials done, trials in all)
-
-
-@dataclass
-class TuneResult:
-    tune: Tune
-    rows: list[dict[str, Any]]  # one per trial, in trial order
-    interrupted: bool = False
-    wall_time: float = 0.0
-    study_rows: int = 0  # study rows run by this call (resumed trials not counted)
-    best: list[dict[str, Any]] = field(default_factory=list)  # best trial, or the front
-
-    @property
-    def targets(self) -> bool:
-        return bool(self.tune.spec.targets)
-
-    def fits(self) -> list[dict[str, Any]]:
-        """Targets: every feasible trial that reproduces all targets within sampling error."""
-        return [r for r in self.rows if r["state"] == "ok" and r["feasible"]
-                and r["score"] <= Z95]
 
 
 def run_tune(tune: Tune, *, workers: int | None = None, backend: str = "local",
@@ -93,8 +73,6 @@ def run_tune(tune: Tune, *, workers: int | None = None, backend: str = "local",
     result = TuneResult(tune, rows, interrupted, time.perf_counter() - t0, ran)
     result.best = _best(result)
     if folder is not None:
-        from astralis_des.studies.tune_output import write_tune
-
         write_tune(result, folder)
     return result
 
@@ -282,8 +260,6 @@ def _start(tune: Tune, folder: Path | None, resume: bool) -> list[dict[str, Any]
                                    for r in [header, *done]), encoding="utf-8")
         return done
     folder.mkdir(parents=True, exist_ok=True)
-    from astralis_des.studies.tune_output import TUNE_FILES
-
     for name in TUNE_FILES:  # never a file of an earlier tune beside this one's
         path = folder / name
         if path.is_dir():

@@ -10,14 +10,31 @@ from __future__ import annotations
 import json
 import math
 import platform
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from astralis_des.studies.table import Z95, write_table
-from astralis_des.studies.tune import JOURNAL, TuneResult
+from astralis_des.studies.tune_spec import Tune
 
+JOURNAL = "trials.jsonl"
 TUNE_FILES = (JOURNAL, "trials.csv", "trials.parquet", "best.json", "report.md", "tune.yaml",
               "meta.json", "plots")
+
+
+@dataclass
+class TuneResult:
+    tune: Tune
+    rows: list[dict[str, Any]]  # one per trial, in trial order
+    interrupted: bool = False
+    wall_time: float = 0.0
+    study_rows: int = 0  # study rows run by this call (resumed trials not counted)
+    best: list[dict[str, Any]] = field(default_factory=list)  # best trial, or the front
+
+    def fits(self) -> list[dict[str, Any]]:
+        """Targets: every feasible trial that reproduces all targets within sampling error."""
+        return [r for r in self.rows if r["state"] == "ok" and r["feasible"]
+                and r["score"] <= Z95]
 
 
 def write_tune(result: TuneResult, folder: Path) -> None:
