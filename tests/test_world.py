@@ -118,3 +118,15 @@ def test_a_world_file_edited_between_two_loads_is_read_anew(tmp_path: Path) -> N
     path.write_text(body % "HQ", encoding="utf-8")
     assert list(load_world(path).buildings) == ["HQ"]
     assert load_world(path) is load_world(path)  # the same file is built once
+
+
+def test_a_world_of_too_many_rooms_is_refused_at_once(tmp_path: Path) -> None:
+    # found by the fuzzer: 388 floors of 516 rooms (200,232 rooms) were built before the site
+    # check refused them: 42 s to a one-line error
+    path = tmp_path / "w.yaml"
+    path.write_text("name: w\nsite: {size: [3500, 4700]}\nbuildings:\n  - {id: t, origin: "
+                    "[1, 1], floors: 388, segments: [{side: south, rooms: 516}]}\n",
+                    encoding="utf-8")
+    with pytest.raises(InputError, match=r"w.yaml:\d+: buildings\[0\]: building t has "
+                                         r"200,208 rooms; a world holds at most 10,000"):
+        load_world(path)

@@ -53,6 +53,9 @@ def files(kind: str, examples: int, seed: int, out: str) -> dict[str, Any]:
         if outcome.seconds > max(times, default=0.0):  # keep the slowest, to look at
             case.save(Path(out) / f"slowest-{kind}-{seed}")
         times.append(outcome.seconds)
+        if len(times) % 1000 == 0:  # what an interrupted run can still report
+            (Path(out) / f"tally-{kind}-{seed}.json").write_text(
+                json.dumps({"tally": dict(tally), "cases": len(times), "max_s": max(times)}))
         if not outcome.ok:
             where = Path(out) / "failures" / f"{kind}-{seed}-{sum(tally.values())}"
             case.save(where)

@@ -120,6 +120,8 @@ def run_case(case: Case, folder: Path, limit: float = 30.0) -> Outcome:
     except BaseException as exc:  # what a user would see as a traceback
         return Outcome("traceback", time.perf_counter() - t0, f"{type(exc).__name__}: {exc}")
     seconds = time.perf_counter() - t0
+    if seconds > limit:  # the alarm fired where it could not stop the case (a GC callback)
+        return Outcome("hang", seconds, f"{seconds:.1f} s")
     text = stderr.getvalue()
     if caught:
         w = caught[0]
