@@ -28,7 +28,9 @@ SCALE = float(os.environ.get("ASTRALIS_FUZZ_SCALE", "1"))
 
 
 def fuzz(kind: str) -> settings:
+    # derandomize: the same cases on every run, so that the suite is as reproducible as a run
     return settings(max_examples=int(EXAMPLES[kind] * SCALE), deadline=None, database=None,
+                    derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
                                            HealthCheck.function_scoped_fixture])
 

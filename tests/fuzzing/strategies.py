@@ -16,6 +16,7 @@ Three sources, mixed:
 
 from __future__ import annotations
 
+import copy
 import functools
 import json
 import re
@@ -116,11 +117,17 @@ EXTREMES: tuple[Any, ...] = (
     None, [], {}, [[]], {"": None})
 
 
+def extremes() -> st.SearchStrategy[Any]:
+    """One of :data:`EXTREMES`, a fresh copy: a mutation changes lists and dicts in place, and
+    a shared one would make the next example differ (Hypothesis: FlakyStrategyDefinition)."""
+    return st.sampled_from(EXTREMES).map(copy.deepcopy)
+
+
 def json_values() -> st.SearchStrategy[Any]:
     """Any JSON-like value, small: what a careless hand or a broken generator writes."""
     leaves = st.one_of(st.none(), st.booleans(), st.integers(-10**6, 10**6),
                        st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=12),
-                       st.sampled_from(EXTREMES))
+                       extremes())
     return st.recursive(leaves, lambda inner: st.one_of(
         st.lists(inner, max_size=3), st.dictionaries(names(), inner, max_size=3)),
         max_leaves=8)
@@ -256,7 +263,7 @@ def _replacement(draw: st.DrawFn, old: Any) -> Any:
     if how == "junk":
         return draw(json_values())
     if how == "extreme":
-        return draw(st.sampled_from(EXTREMES))
+        return draw(extremes())
     if how == "nest":
         return NEST.format(draw(st.sampled_from([2, 40, 63, 64, 65, 200, 5000])))
     if how == "long":
