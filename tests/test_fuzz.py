@@ -15,12 +15,11 @@ from pathlib import Path
 
 import pytest
 import zmq
-from fuzzing.cases import Case, run_case
+from fuzzing.cases import Case, dealer_to, run_case
 from fuzzing.strategies import mission_cases, requests, study_cases
 from hypothesis import HealthCheck, given, settings
 
 from astralis_des import Mission
-from astralis_des.api.local import Background
 
 FOUND = Path(__file__).parent / "fuzzing" / "found"
 EXAMPLES = {"missions": 150, "studies": 12, "requests": 400}
@@ -68,15 +67,8 @@ def test_a_case_the_fuzzer_found_stays_fixed(found: str, tmp_path: Path) -> None
 
 @pytest.fixture(scope="module")
 def dealer(urban_search: Mission) -> Iterator[zmq.Socket[bytes]]:
-    server = Background(urban_search.with_changes(assignment={"auto": False, "search": ["A"]}),
-                        running=False)
-    server.start()
-    ctx = zmq.Context()
-    socket = ctx.socket(zmq.DEALER)
-    socket.connect(server.address)
-    yield socket
-    ctx.destroy(linger=0)
-    server.stop()
+    with dealer_to(urban_search) as socket:
+        yield socket
 
 
 @fuzz("requests")

@@ -67,21 +67,14 @@ def files(kind: str, examples: int, seed: int, out: str) -> dict[str, Any]:
 
 def api(examples: int, seed: int, out: str) -> dict[str, Any]:
     """Send ``examples`` generated requests to a server of the default mission."""
-    import zmq
+    from fuzzing.cases import dealer_to
     from fuzzing.strategies import requests
     from hypothesis import given
     from hypothesis import seed as with_seed
 
     from astralis_des import load_mission
-    from astralis_des.api.local import Background
 
     mission = load_mission(ROOT / "missions" / "urban_search.yaml")
-    server = Background(mission.with_changes(assignment={"auto": False, "search": ["A"]}),
-                        running=False)
-    server.start()
-    ctx = zmq.Context()
-    dealer = ctx.socket(zmq.DEALER)
-    dealer.connect(server.address)
     tally: Counter[str] = Counter()
     times: list[float] = []
 
@@ -106,13 +99,10 @@ def api(examples: int, seed: int, out: str) -> dict[str, Any]:
             where.write_text(json.dumps({"frames": [f.decode("latin-1") for f in frames],
                                          "reply": reply}, indent=2))
 
-    try:
+    with dealer_to(mission) as dealer:
         one()
         dealer.send_multipart([b"", b'{"op": "info"}'])
         alive = bool(dealer.poll(5000)) and json.loads(dealer.recv_multipart()[-1])["ok"]
-    finally:
-        ctx.destroy(linger=0)
-        server.stop()
     return {"tally": dict(tally), "times": times, "alive": alive}
 
 

@@ -36,7 +36,8 @@ def study_command(args: argparse.Namespace) -> int:
     out = Path(args.out or Path("out") / study.name)
     console = Console(stderr=True, quiet=args.quiet)
     try:
-        result = _with_progress(console, study, lambda progress: run_study(
+        result = with_progress(console, study.name, "scenarios", study.scenarios,
+                               lambda progress: run_study(
             study, workers=args.workers, backend=args.backend, address=args.address, out=out,
             recordings=True if args.recordings else None, progress=progress))
     except KeyboardInterrupt:  # before the first scenario was under way
@@ -105,7 +106,9 @@ def _rich(table: TextTable) -> Table:
     return out
 
 
-def _with_progress(console: Console, study: Study, run: Any) -> Any:
+def with_progress(console: Console, name: str, unit: str, total: int, run: Any) -> Any:
+    """``run(progress)`` under a progress bar of ``total`` ``unit``; ``progress(done, total)``
+    moves it (and may change its total)."""
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -115,8 +118,8 @@ def _with_progress(console: Console, study: Study, run: Any) -> Any:
         TimeRemainingColumn,
     )
 
-    columns = (TextColumn(f"[bold]{study.name}"), BarColumn(), MofNCompleteColumn(),
-               TextColumn("scenarios"), TimeElapsedColumn(), TimeRemainingColumn())
+    columns = (TextColumn(f"[bold]{name}"), BarColumn(), MofNCompleteColumn(),
+               TextColumn(unit), TimeElapsedColumn(), TimeRemainingColumn())
     with Progress(*columns, console=console, transient=False) as bar:
-        task = bar.add_task("study", total=study.scenarios)
-        return run(lambda done, total: bar.update(task, completed=done))
+        task = bar.add_task(name, total=total)
+        return run(lambda done, all_: bar.update(task, completed=done, total=all_))

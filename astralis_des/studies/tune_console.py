@@ -11,6 +11,7 @@ from rich.markdown import Markdown
 from astralis_des.errors import InputError
 from astralis_des.exits import EXIT_INTERRUPTED
 from astralis_des.studies.backends import make_backend
+from astralis_des.studies.console import with_progress
 from astralis_des.studies.tune import run_tune
 from astralis_des.studies.tune_output import report
 from astralis_des.studies.tune_spec import Tune, load_tune
@@ -27,23 +28,10 @@ def tune_command(args: argparse.Namespace) -> int:
         raise InputError(exc.message, key=f"--{exc.key}") from None
     out = Path(args.out or Path("out") / tune.name)
     console = Console(stderr=True, quiet=args.quiet)
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
-
-    columns = (TextColumn(f"[bold]{tune.name}"), BarColumn(), MofNCompleteColumn(),
-               TextColumn("trials"), TimeElapsedColumn(), TimeRemainingColumn())
-    with Progress(*columns, console=console, transient=False) as bar:
-        task = bar.add_task("tune", total=tune.spec.trials)
-        result = run_tune(tune, workers=args.workers, backend=args.backend,
-                          address=args.address, out=out, resume=args.resume,
-                          progress=lambda done, total: bar.update(task, completed=done,
-                                                                      total=total))
+    result = with_progress(console, tune.name, "trials", tune.spec.trials,
+                           lambda progress: run_tune(
+        tune, workers=args.workers, backend=args.backend, address=args.address, out=out,
+        resume=args.resume, progress=progress))
     if result.interrupted:
         console.print(f"[yellow]interrupted[/]; the {len(result.rows)} trials done are in "
                       f"{out}/ (go on with --resume)")

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from astralis_des.sinks import write_atomic
 from astralis_des.studies.table import Z95, write_table
 from astralis_des.studies.tune_spec import Tune
 
@@ -47,23 +48,17 @@ def write_tune(result: TuneResult, folder: Path) -> None:
         columns = list(dict.fromkeys(["trial", *(k for r in result.rows for k in r)]))
         table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in result.rows])
         write_table(table, folder, "trials")
-    _atomic(folder / "best.json", json.dumps(result.best, indent=2) + "\n")
-    _atomic(folder / "report.md", "\n".join(report(result)) + "\n")
-    _atomic(folder / "tune.yaml", result.tune.text)
+    write_atomic(folder / "best.json", json.dumps(result.best, indent=2) + "\n")
+    write_atomic(folder / "report.md", "\n".join(report(result)) + "\n")
+    write_atomic(folder / "tune.yaml", result.tune.text)
     meta = {"astralis_des": __version__, "tune": result.tune.name, "seed": result.tune.spec.seed,
             "sampler": result.tune.spec.sampler, "trials": len(result.rows),
             "trials_asked": result.tune.spec.trials, "interrupted": result.interrupted,
             "scenarios": result.tune.study.scenarios, "wall_time_s": round(result.wall_time, 3),
             "python": platform.python_version()}
-    _atomic(folder / "meta.json", json.dumps(meta, indent=2) + "\n")
+    write_atomic(folder / "meta.json", json.dumps(meta, indent=2) + "\n")
     if result.rows:
         write_plots(result, folder / "plots")
-
-
-def _atomic(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
 
 
 def _fmt(value: Any) -> str:

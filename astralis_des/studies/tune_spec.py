@@ -118,9 +118,7 @@ class Tune:
 
     def metrics(self) -> list[str]:
         """Every metric the tune reads (variant.metric), in file order."""
-        named = [*self.spec.targets, *(o.metric for o in self.spec.objectives),
-                 *(c.metric for c in self.spec.constraints)]
-        return list(dict.fromkeys(named))
+        return list(dict.fromkeys(metric for _, metric in metric_keys(self.spec)))
 
 
 def load_tune(path: str | Path) -> Tune:
@@ -166,13 +164,15 @@ def check_tune(tune: Tune, doc: LocatedYaml) -> None:
                                 f"{str(exc).splitlines()[-1].strip()}") from None
     columns = [m.column for m in EVALUATIONS.get(study.spec.evaluate).metrics]
     variants = [v.name for v in study.variants]
-    places = [*(("targets", k) for k in tune.spec.targets),
-              *(("objectives", i, "metric") for i, _ in enumerate(tune.spec.objectives)),
-              *(("constraints", i, "metric") for i, _ in enumerate(tune.spec.constraints))]
-    named = [*tune.spec.targets, *(o.metric for o in tune.spec.objectives),
-             *(c.metric for c in tune.spec.constraints)]
-    for place, metric in zip(places, named, strict=True):
+    for place, metric in metric_keys(tune.spec):
         split_metric(metric, variants, columns, lambda msg, p=place: doc.error(p, msg))
+
+
+def metric_keys(spec: TuneSpec) -> list[tuple[tuple[str | int, ...], str]]:
+    """Each metric the file names, with the key that names it, in file order."""
+    return [*((("targets", k), k) for k in spec.targets),
+            *((("objectives", i, "metric"), o.metric) for i, o in enumerate(spec.objectives)),
+            *((("constraints", i, "metric"), c.metric) for i, c in enumerate(spec.constraints))]
 
 
 def split_metric(name: str, variants: list[str], columns: list[str],

@@ -79,6 +79,27 @@ def _alarm(limit: float) -> Iterator[None]:
         signal.signal(signal.SIGALRM, old)
 
 
+@contextlib.contextmanager
+def dealer_to(mission: Any) -> Iterator[Any]:
+    """A ZeroMQ DEALER connected to a server of ``mission`` that waits for commands (its clock
+    paused, no automatic rounds): where generated requests go."""
+    import zmq
+
+    from astralis_des.api.local import Background
+
+    server = Background(mission.with_changes(assignment={"auto": False, "search": ["A"]}),
+                        running=False)
+    server.start()
+    ctx = zmq.Context()
+    socket = ctx.socket(zmq.DEALER)
+    socket.connect(server.address)
+    try:
+        yield socket
+    finally:
+        ctx.destroy(linger=0)
+        server.stop()
+
+
 def _fidelity(mission: bytes) -> Any:
     try:
         doc = yaml.load(mission, Loader=yaml.CSafeLoader)
