@@ -25,7 +25,7 @@ from functools import lru_cache
 import numpy as np
 
 from astralis_des.kinds import TARGET_SIZE
-from astralis_des.view import View
+from astralis_des.view import Axes, View
 from astralis_des.world.geometry import FloatArray
 
 SAMPLES = 5  # per side of each face, where something may hide part of the target (a strip
@@ -90,7 +90,7 @@ def target_samples(eyes: FloatArray, centres: FloatArray, size: FloatArray,
 
 
 def predict_pixels(view: View, eyes: FloatArray, headings: FloatArray, centres: FloatArray,
-                   size: FloatArray, sight: Sight | None) -> FloatArray:
+                   size: FloatArray, sight: Sight | None, axes: Axes | None = None) -> FloatArray:
     """The target's pixels in the frame of each camera (``eyes[m]`` facing ``headings[m]``,
     the target's box at ``centres[m]``): unoccluded when ``sight`` is None (sampled
     ``COARSE``), else counting only the samples it calls clear (sampled ``SAMPLES``)."""
@@ -99,7 +99,8 @@ def predict_pixels(view: View, eyes: FloatArray, headings: FloatArray, centres: 
     if len(eyes) == 0:
         return np.zeros(0)
     points, area = target_samples(eyes, centres, size, COARSE if sight is None else SAMPLES)
-    right, down, forward = view.axes(np.asarray(headings, dtype=float))
+    right, down, forward = (view.axes(np.asarray(headings, dtype=float)) if axes is None
+                            else axes)
     rays = points - eyes[:, None, :]
     x = np.einsum("mkj,mj->mk", rays, right)
     y = np.einsum("mkj,mj->mk", rays, down)

@@ -45,24 +45,40 @@ def default_termination() -> None:
         signal.signal(sig, signal.SIG_DFL)
 
 
+class Deferral:
+    """Ctrl-C, SIGTERM and SIGHUP held from :meth:`hold` until the ``with`` block ends, then
+    raised as a ``KeyboardInterrupt``: for steps that must not be cut in half (opening a run's
+    outputs, writing a study's folder and putting it in place). Only the signals that interrupt
+    already (a handler in Python) are held; one left to its default (a library user's process)
+    keeps it."""
+
+    def __init__(self, *, raise_after: bool = True) -> None:
+        self.raise_after = raise_after  # False: the caller reads ``caught``
+        self.caught: list[int] = []
+        self.before: dict[signal.Signals, object] = {}
+
+    def hold(self) -> None:
+        if self.before or not _main_thread():
+            return
+        self.before = {sig: signal.getsignal(sig) for sig in _signals(("SIGINT", *TERMINATION))
+                       if callable(signal.getsignal(sig))}
+        for sig in self.before:
+            signal.signal(sig, lambda signum, frame: self.caught.append(signum))
+
+    def __enter__(self) -> Deferral:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for sig, handler in self.before.items():
+            signal.signal(sig, handler)  # type: ignore[arg-type]
+        self.before = {}
+        if self.caught and exc[0] is None and self.raise_after:
+            raise KeyboardInterrupt(signal.Signals(self.caught[0]).name)
+
+
 @contextlib.contextmanager
 def deferred_interrupts() -> Iterator[None]:
-    """Hold Ctrl-C, SIGTERM and SIGHUP until the block ends, then interrupt: for short steps
-    that must not be cut in half (opening a run's outputs and logging its start)."""
-    if not _main_thread():
+    """Hold Ctrl-C, SIGTERM and SIGHUP until the block ends, then interrupt."""
+    with Deferral() as deferral:
+        deferral.hold()
         yield
-        return
-    caught: list[int] = []
-    # only the signals that interrupt already (a handler in Python); one left to its default
-    # (a library user's process) keeps it
-    before = {sig: signal.getsignal(sig) for sig in _signals(("SIGINT", *TERMINATION))
-              if callable(signal.getsignal(sig))}
-    for sig in before:
-        signal.signal(sig, lambda signum, frame: caught.append(signum))
-    try:
-        yield
-    finally:
-        for sig, handler in before.items():
-            signal.signal(sig, handler)
-    if caught:
-        raise KeyboardInterrupt(signal.Signals(caught[0]).name)

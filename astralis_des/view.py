@@ -15,6 +15,12 @@ import numpy as np
 from astralis_des.world.geometry import FloatArray
 
 LOOK_AROUND = 8  # headings a camera that pans a full turn looks along
+Axes = tuple[FloatArray, FloatArray, FloatArray]  # right, down, forward: one row per heading
+
+
+def pick(axes: Axes, rows: np.ndarray) -> Axes:
+    """The rows ``rows`` of ``axes`` (the same numbers as the axes of those headings)."""
+    return axes[0][rows], axes[1][rows], axes[2][rows]
 
 
 @dataclass(frozen=True)
@@ -60,7 +66,7 @@ class View:
     def tan_h(self) -> float:
         return self.tan_v * self.aspect
 
-    def axes(self, headings: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    def axes(self, headings: FloatArray) -> Axes:
         """Camera right, down and forward unit vectors in the world, one row per heading."""
         h = np.asarray(headings, dtype=float)
         p = math.radians(self.pitch_deg)
@@ -69,11 +75,13 @@ class View:
         right = np.column_stack([np.sin(h), -np.cos(h), np.zeros(h.shape)])
         return right, np.cross(forward, right), forward
 
-    def sees(self, eyes: FloatArray, headings: FloatArray, points: FloatArray) -> FloatArray:
+    def sees(self, eyes: FloatArray, headings: FloatArray, points: FloatArray,
+             axes: Axes | None = None) -> FloatArray:
         """Which ``points`` are in range and in the frustum of the camera at ``eyes`` facing
-        ``headings`` (row by row; sight lines are not checked)."""
+        ``headings`` (row by row; sight lines are not checked). ``axes``: those of
+        ``headings``, when the caller has them already."""
         d = np.asarray(points, dtype=float) - np.asarray(eyes, dtype=float)
-        right, down, forward = self.axes(headings)
+        right, down, forward = self.axes(headings) if axes is None else axes
         z = np.einsum("ij,ij->i", d, forward)
         x = np.abs(np.einsum("ij,ij->i", d, right))
         y = np.abs(np.einsum("ij,ij->i", d, down))

@@ -106,7 +106,7 @@ def test_a_terminated_study_keeps_the_rows_it_finished(tmp_path: Path) -> None:
     the rows of the scenarios finished (whole scenarios: every variant), its meta.json
     marked interrupted."""
     out = tmp_path / "study"
-    proc = astralis("study", str(ROOT / "studies" / "outcomes.yaml"), "--scenarios", "60",
+    proc = astralis("study", str(ROOT / "studies" / "outcomes.yaml"), "--scenarios", "600",
                     "--workers", "2", "--out", str(out), "--quiet")
     time.sleep(12.0)
     assert proc.poll() is None, "the study ended before it could be interrupted"
@@ -117,4 +117,34 @@ def test_a_terminated_study_keeps_the_rows_it_finished(tmp_path: Path) -> None:
     assert meta["interrupted"] is True
     with (out / "table.csv").open(encoding="utf-8") as f:
         rows = list(csv.DictReader(f))
-    assert 0 < len(rows) == meta["rows"] < 180 and len(rows) % 3 == 0
+    assert 0 < len(rows) == meta["rows"] < 1800 and len(rows) % 3 == 0
+
+
+def test_a_signal_while_the_study_folder_is_written_keeps_it_whole(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """SIGTERM after the last scenario, while the folder is being written: the folder is
+    finished and put in place with every row, and the result says it was interrupted."""
+    from astralis_des.exits import interrupt_on_termination
+    from astralis_des.studies import output, runner
+    from astralis_des.studies.spec import load_study
+
+    study = load_study(ROOT / "studies" / "table5.yaml").with_changes(scenarios=20)
+    fill = output.fill_folder
+
+    def fill_and_terminate(result: runner.StudyResult, folder: Path) -> None:
+        os.kill(os.getpid(), signal.SIGTERM)  # held until the folder is in place
+        fill(result, folder)
+
+    before = {sig: signal.getsignal(sig) for sig in (signal.SIGTERM, signal.SIGHUP)}
+    interrupt_on_termination()
+    monkeypatch.setattr(runner, "fill_folder", fill_and_terminate)
+    try:
+        result = runner.run_study(study, workers=1, out=tmp_path / "study")
+    finally:
+        for sig, handler in before.items():
+            signal.signal(sig, handler)
+    assert result.interrupted
+    assert len(result.rows) == 40
+    with (tmp_path / "study" / "table.csv").open(encoding="utf-8") as f:
+        assert len(list(csv.DictReader(f))) == 40
+    assert not list(tmp_path.glob(".study.partial-*"))

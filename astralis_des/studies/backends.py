@@ -24,10 +24,17 @@ log = logging.getLogger(__name__)
 
 
 class Backend(Protocol):
+    name: str  # as registered
     workers: int
 
     def run(self, study: Study, chunks: Sequence[list[int]],
             recordings: Path | None) -> Generator[ChunkResult, None, None]: ...
+
+    def hold(self, base: Study) -> None:
+        """Keep the workers for the runs that follow, of studies made from ``base`` by
+        ``with_changes`` (a tune's trials), until :meth:`close`."""
+
+    def close(self) -> None: ...
 
 
 BACKENDS: Registry[str, Callable[[int, str | None], Backend]] = Registry("study backend")
@@ -55,20 +62,57 @@ def _chunk_in_worker(job: tuple[list[int], Path | None]) -> ChunkResult:
     return run_chunk(_STUDY, *job)
 
 
+_MADE: list[tuple[dict[str, Any], Study]] = []  # a held pool's worker: the last study it made
+
+
+def _changed_chunk_in_worker(job: tuple[dict[str, Any], list[int], Path | None]) -> ChunkResult:
+    """A chunk of ``_STUDY.with_changes(**changes)``, the study made once per worker and run."""
+    assert _STUDY is not None
+    changes, indices, recordings = job
+    if not _MADE or _MADE[0][0] != changes:
+        _MADE[:] = [(changes, _STUDY.with_changes(**changes))]
+    return run_chunk(_MADE[0][1], indices, recordings)
+
+
 class LocalBackend:
     """This process for one worker, else a pool of processes that each get the study once."""
+
+    name = "local"
 
     def __init__(self, workers: int, address: str | None = None) -> None:
         if address is not None:
             raise InputError("the local backend takes no address (it is for ray)",
                              key="address")
         self.workers = max(1, workers)
+        self._held: tuple[Study, Any] | None = None  # the base study and its pool
+
+    def hold(self, base: Study) -> None:
+        """One pool for the runs that follow, its workers holding ``base``: a study made from
+        it by ``with_changes`` is sent as its changes, and what the workers keep on the world
+        (free floor, furnished rooms) lasts from one run to the next."""
+        self.close()
+        if self.workers > 1:
+            pool = multiprocessing.get_context("fork").Pool(
+                self.workers, initializer=_take_study, initargs=(base,))
+            self._held = (base, pool)
+
+    def close(self) -> None:
+        if self._held is not None:
+            self._held[1].terminate()
+            self._held[1].join()
+            self._held = None
 
     def run(self, study: Study, chunks: Sequence[list[int]],
             recordings: Path | None) -> Generator[ChunkResult, None, None]:
         if self.workers == 1 or len(chunks) == 1:
             for chunk in chunks:
                 yield run_chunk(study, chunk, recordings)
+            return
+        held = self._held
+        if held is not None and study.origin is not None and study.origin[0] is held[0]:
+            changes = study.origin[1]
+            yield from held[1].imap_unordered(_changed_chunk_in_worker,
+                                              [(changes, c, recordings) for c in chunks])
             return
         # Leaving the pool's block terminates its workers, also on Ctrl-C or an error.
         with multiprocessing.get_context("fork").Pool(
@@ -94,6 +138,8 @@ class _RayWorker:
 class RayBackend:
     """``ray.init(address=...)`` for an existing cluster, else a local instance of ``workers``
     CPUs; one actor per CPU (as many as the cluster has, with an address)."""
+
+    name = "ray"
 
     def __init__(self, workers: int, address: str | None = None) -> None:
         try:
@@ -131,6 +177,13 @@ class RayBackend:
                 ray.kill(a)
             if started:
                 ray.shutdown()
+
+
+    def hold(self, base: Study) -> None:
+        """Nothing kept: each run starts its actors (a cluster's are shared)."""
+
+    def close(self) -> None:
+        pass
 
 
 BACKENDS.register("ray")(RayBackend)

@@ -14,7 +14,8 @@ from contextlib import closing
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from astralis_des.studies.backends import make_backend
+from astralis_des.exits import Deferral
+from astralis_des.studies.backends import Backend, make_backend
 from astralis_des.studies.output import fill_folder, staging
 from astralis_des.studies.results import StudyResult
 from astralis_des.studies.scenarios import ChunkResult, chunks, evaluation_of, run_scenario
@@ -27,27 +28,31 @@ Progress = Callable[[int, int], None]  # (scenarios done, scenarios in all)
 SCENARIOS_DIR = "scenarios"
 
 
-def run_study(study: Study, *, workers: int | None = None, backend: str = "local",
+def run_study(study: Study, *, workers: int | None = None, backend: str | Backend = "local",
               address: str | None = None, out: str | Path | None = None,
               recordings: bool | None = None, progress: Progress | None = None) -> StudyResult:
     """Run every scenario of ``study`` under every variant.
 
     ``workers``: processes (default: the CPUs); ``backend``: ``local`` (a process pool) or
-    ``ray`` (``address`` for an existing cluster, else a local instance). With ``out``, the
+    ``ray`` (``address`` for an existing cluster, else a local instance), or a backend made
+    and held by the caller (:meth:`Backend.hold`, a tune's trials). With ``out``, the
     study folder is written there, all or nothing; ``recordings`` (default: the study file's
     ``outputs.recordings``) writes each mission's outputs under it. Interrupted (Ctrl-C,
     SIGTERM, SIGHUP), it returns, and writes, the rows of the scenarios done, with
     ``interrupted`` set.
     """
     workers = workers or os.cpu_count() or 1
-    runner = make_backend(backend, workers, address)
+    runner = make_backend(backend, workers, address) if isinstance(backend, str) else backend
     record = study.spec.outputs.recordings if recordings is None else recordings
     if record and out is None:
         from astralis_des.errors import InputError
 
         raise InputError("recordings need an output folder", key="recordings")
     t0 = time.perf_counter()
-    with staging(Path(out) if out is not None else None) as tmp:
+    # once the scenarios are done, or interrupted, the folder is written whole and put in
+    # place; a signal meanwhile marks the result interrupted
+    shield = Deferral(raise_after=False)
+    with shield, staging(Path(out) if out is not None else None) as tmp:
         rec_dir = tmp / SCENARIOS_DIR if (tmp is not None and record) else None
         rows: list[dict[str, Any]] = []
         failures: list[str] = []
@@ -62,12 +67,17 @@ def run_study(study: Study, *, workers: int | None = None, backend: str = "local
                     done += part.scenarios
                     if progress is not None:
                         progress(done, study.scenarios)
+                if tmp is not None:
+                    shield.hold()
             except KeyboardInterrupt:  # keep the scenarios done
                 interrupted = True
+                if tmp is not None:
+                    shield.hold()
         order = {v.name: v.index for v in study.variants}
         rows.sort(key=lambda r: (r["scenario"], order[r["variant"]]))
-        result = StudyResult(study, rows, failures, time.perf_counter() - t0, backend,
+        result = StudyResult(study, rows, failures, time.perf_counter() - t0, runner.name,
                              runner.workers, interrupted)
         if tmp is not None:
             fill_folder(result, tmp)
+    result.interrupted = result.interrupted or bool(shield.caught)
     return result

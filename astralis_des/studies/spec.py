@@ -14,7 +14,7 @@ Every problem is an :class:`InputError` naming the file, line and key, as for mi
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -97,6 +97,12 @@ class Study:
     segments: tuple[str, ...]
     text: str  # the study file, copied into the output folder
     path: Path | None = None
+    # the study this one was made from by with_changes, and the changes (not pickled: a pool
+    # holding the origin is sent the changes alone)
+    origin: tuple[Study, dict[str, Any]] | None = field(default=None, compare=False, repr=False)
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {**self.__dict__, "origin": None}
 
     @property
     def name(self) -> str:
@@ -125,7 +131,7 @@ class Study:
         doc = LocatedYaml(data, {}, self.path or Path("<study>"))
         note = "".join(f"# changed for this run: {k}: {v!r}\n" for k, v in changes.items())
         return replace(_build(validate(StudySpec, doc), self.mission, doc, self.text + note),
-                       path=self.path)
+                       path=self.path, origin=(self, dict(changes)))
 
 
 def load_study(path: str | Path) -> Study:

@@ -14,12 +14,14 @@ import hashlib
 import itertools
 import json
 import math
+import os
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from astralis_des.errors import InputError
+from astralis_des.studies.backends import Backend, make_backend
 from astralis_des.studies.runner import run_study
 from astralis_des.studies.table import Z95, two_proportion_z
 from astralis_des.studies.tune_output import JOURNAL, TUNE_FILES, TuneResult, write_tune
@@ -48,13 +50,17 @@ def run_tune(tune: Tune, *, workers: int | None = None, backend: str = "local",
     t0, ran, interrupted = time.perf_counter(), 0, False
     points = _grid_points(tune) if tune.spec.sampler == "grid" else None
     total = min(tune.spec.trials, len(points)) if points is not None else tune.spec.trials
+    # one set of workers for every trial, holding the base study and what they cache on its
+    # world (free floor, furnished rooms): a trial sends its parameters alone
+    runner = make_backend(backend, workers or os.cpu_count() or 1, address)
     try:
+        runner.hold(tune.study)
         for number in range(len(done), total):
             study.sampler = _sampler(tune, number)
             if points is not None:  # the grid in order: each point once
                 study.enqueue_trial(points[number])
             trial = study.ask(spaces)
-            row, values, constraints = evaluate(tune, trial.params, workers, backend, address)
+            row, values, constraints = evaluate(tune, trial.params, runner)
             ran += row.pop("_rows")
             row["trial"] = number
             for i, value in enumerate(constraints):  # <= 0: met; the samplers read these
@@ -70,6 +76,8 @@ def run_tune(tune: Tune, *, workers: int | None = None, backend: str = "local",
                 progress(number + 1, total)
     except KeyboardInterrupt:
         interrupted = True
+    finally:
+        runner.close()
     result = TuneResult(tune, rows, interrupted, time.perf_counter() - t0, ran)
     result.best = _best(result)
     if folder is not None:
@@ -78,15 +86,15 @@ def run_tune(tune: Tune, *, workers: int | None = None, backend: str = "local",
 
 
 # -- one trial -------------------------------------------------------------------------------
-def evaluate(tune: Tune, params: dict[str, Any], workers: int | None, backend: str,
-             address: str | None) -> tuple[dict[str, Any], list[float], list[float]]:
+def evaluate(tune: Tune, params: dict[str, Any],
+             runner: Backend) -> tuple[dict[str, Any], list[float], list[float]]:
     """Run the study with ``params`` set; the trial's row, its objective values (empty if
     the study failed) and its constraint values (<= 0 is feasible)."""
     base = tune.study
     values_set = {k: _unplain(tune, k, v) for k, v in params.items()}
     study = base.with_changes(set={**base.spec.set, **values_set})
     t0 = time.perf_counter()
-    result = run_study(study, workers=workers, backend=backend, address=address)
+    result = run_study(study, backend=runner)
     if result.interrupted:
         raise KeyboardInterrupt
     entries = {(e["variant"], e["metric"]): e for e in result.summary()}

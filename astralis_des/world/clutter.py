@@ -121,6 +121,27 @@ def place_room(world: World, room_id: str, messiness: float, rng: np.random.Gene
     return Clutter(tuple(placed), tuple(skipped))
 
 
+MEMO_ROOMS = 4096  # furnished rooms a world keeps in memory (a tune's trials reuse them)
+
+
+def furnish(world: World, room_id: str, messiness: float, seed: int, index: int,
+            catalogue: Catalogue) -> Clutter:
+    """:func:`place_room` with the room's own generator, ``stream(seed, "clutter", index)``.
+
+    The result depends on its arguments alone, so it is kept on the world: the same room,
+    messiness and seed in a later mission of this process (a study's next variant, a tune's next
+    trial) is furnished from memory, identical to placing it again.
+    """
+    memo = world.memo("furnished", MEMO_ROOMS)
+    key = (room_id, messiness, seed, index)
+    kept = memo.get(key)
+    if kept is not None and kept[0] is catalogue:
+        return kept[1]
+    clutter = place_room(world, room_id, messiness, stream(seed, "clutter", index), catalogue)
+    memo[key] = (catalogue, clutter)
+    return clutter
+
+
 def place_world(world: World, messiness: Mapping[str, float], seed: int,
                 catalogue: Catalogue | None = None) -> Clutter:
     """Clutter in each room of ``messiness``; a room's result depends only on it and the seed."""

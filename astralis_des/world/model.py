@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -35,6 +35,15 @@ class World:
     stairs_passable_by: dict[str, tuple[str, ...]] = field(default_factory=dict)
     surfaces: tuple[Solid, ...] = ()  # roads and such: drawn, walked on, never in the way
     imported: Imported | None = None  # a digital twin's mesh, cloud and source
+
+    def memo(self, name: str, limit: int) -> dict[Any, Any]:
+        """A cache kept on the world for answers that depend on it and their key alone: it
+        lasts as long as the world (a study's variants, a tune's trials reuse it), emptied when
+        it reaches ``limit`` entries."""
+        kept: dict[Any, Any] = self.__dict__.setdefault(f"_memo_{name}", {})
+        if len(kept) >= limit:
+            kept.clear()
+        return kept
 
     @property
     def map_resolution(self) -> float:

@@ -62,8 +62,9 @@ class Router:
         self._space_ids = list(world.spaces)
         self._space_boxes = boxes_array([s.box for s in world.spaces.values()])
         self._footprints = self._outdoor_blockers()
-        self._snap_boxes = [(r.id, r.box) for r in world.rooms.values()] + [
-            (s.id, s.box) for s in world.spaces.values()]
+        self._snap_ids = [*world.rooms, *world.spaces]
+        self._snap_boxes = boxes_array([r.box for r in world.rooms.values()] +
+                                       [s.box for s in world.spaces.values()])
         self._build()
         self.positions = np.array(self._pos, dtype=float)
         self.dist: dict[str, FloatArray] = {}
@@ -218,15 +219,14 @@ class Router:
 
     def _nearest_space(self, p: FloatArray) -> str | None:
         """The room or space within ``SNAP`` of ``p`` (horizontally, on its level), if any."""
-        best, best_d = None, SNAP
-        for name, box in self._snap_boxes:
-            gap = np.maximum(np.maximum(np.array(box.lo) - p, p - np.array(box.hi)), 0.0)
-            if gap[2] > SNAP:
-                continue
-            d = float(np.linalg.norm(gap))
-            if d < best_d:
-                best, best_d = name, d
-        return best
+        boxes = self._snap_boxes
+        if not len(boxes):
+            return None
+        gap = np.maximum(np.maximum(boxes[:, 0] - p, p - boxes[:, 1]), 0.0)
+        d = np.sqrt(np.einsum("ij,ij->i", gap, gap))
+        d[gap[:, 2] > SNAP] = np.inf
+        best = int(np.argmin(d))  # the first of the nearest, as a scan in order would keep
+        return self._snap_ids[best] if d[best] < SNAP else None
 
     def _entries(self, p: FloatArray, place: str) -> list[int]:
         if place in self.world.rooms:

@@ -20,7 +20,7 @@ from astralis_des.kinds import TARGET_HEIGHT
 from astralis_des.streams import stream
 from astralis_des.world import coverage as cov
 from astralis_des.world.catalogue import Catalogue
-from astralis_des.world.clutter import Clutter, Placed, free_spot, place_room
+from astralis_des.world.clutter import Clutter, Placed, free_spot, furnish
 from astralis_des.world.geometry import Box, FloatArray, boxes_array, segments_hit_boxes
 from astralis_des.world.model import World
 
@@ -115,9 +115,8 @@ class Scene:
             if not self.enabled:
                 self.set_clutter(room_id, Clutter((), ()))
             else:
-                rng = stream(self.seed, "clutter", self._order[room_id])
-                placed = place_room(self.world, room_id, self.messiness.get(room_id, 0.0), rng,
-                                    self.catalogue)
+                placed = furnish(self.world, room_id, self.messiness.get(room_id, 0.0),
+                                 self.seed, self._order[room_id], self.catalogue)
                 self.set_clutter(room_id, self._clear_target(room_id, placed))
                 if self.on_skipped is not None:
                     for skipped in self._rooms[room_id].skipped:
