@@ -16,6 +16,7 @@ from astralis_des.world.clutter import (
     Clutter,
     Placed,
     free_spot,
+    furnish,
     place_room,
     place_world,
 )
@@ -252,3 +253,18 @@ def test_bad_messiness_and_unknown_rooms_are_refused(world: World) -> None:
         place_room(world, "A.1.1.1", 1.5, np.random.default_rng(0))
     with pytest.raises(ValueError, match=r"unknown room 'A\.1\.1\.7'; did you mean"):
         place_world(world, {"A.1.1.7": 0.5}, seed=0)
+
+
+def test_a_room_furnished_again_comes_from_memory_and_is_the_room_placed_anew(
+        world: World) -> None:
+    """A study's next variant or a tune's next trial furnishes the same room with the same
+    seed: the world keeps it, and it is what placing it again gives."""
+    from astralis_des.streams import stream
+
+    catalogue = default_catalogue()
+    first = furnish(world, "A.1.2.2", 0.8, 11, 4, catalogue)
+    assert first == place_room(world, "A.1.2.2", 0.8, stream(11, "clutter", 4), catalogue)
+    assert furnish(world, "A.1.2.2", 0.8, 11, 4, catalogue) is first
+    other = furnish(world, "A.1.2.2", 0.8, 12, 4, catalogue)
+    assert other == place_room(world, "A.1.2.2", 0.8, stream(12, "clutter", 4), catalogue)
+    assert other != first  # another seed, another room

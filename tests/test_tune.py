@@ -77,6 +77,26 @@ def test_the_same_seed_gives_the_same_trials_and_a_resumed_tune_goes_on_as_one(
     assert "## The weights that fit" in (tmp_path / "c" / "report.md").read_text()
 
 
+def test_a_mission_tune_on_two_workers_gives_the_trials_of_one(tmp_path: Path) -> None:
+    """The workers hold the study for every trial and keep what they furnished and swept on
+    its world: the trials are those of a run on one process, number for number."""
+    study = {"name": "m", "mission": str(ROOT / "missions" / "urban_search.yaml"), "seed": 4,
+             "scenarios": 6, "evaluate": "mission",
+             "draw": {"positions": {"type": "outdoor", "radius": 20}},
+             "set": {"fidelity": "kinematic", "strategy": "mixed"}}
+    path = write(tmp_path, {"seed": 1, "trials": 3, "sampler": "random",
+                            "params": {"w1.ugv": {"low": 0, "high": 10},
+                                       "w2.human": {"low": 0, "high": 10}},
+                            "objectives": [{"metric": "time_to_find"},
+                                           {"metric": "ugv_high_mess_s"}]}, study)
+    tune = load_tune(path)
+    one, two = run_tune(tune, workers=1), run_tune(tune, workers=2)
+    drop = ("seconds",)
+    assert [{k: v for k, v in r.items() if k not in drop} for r in two.rows] == \
+        [{k: v for k, v in r.items() if k not in drop} for r in one.rows]
+    assert len({r["time_to_find"] for r in one.rows}) > 1  # the weights changed the missions
+
+
 def test_ctrl_c_keeps_the_trials_done(tmp_path: Path) -> None:
     path = write(tmp_path, {"seed": 1, "trials": 10, "sampler": "random",
                             "params": {"w1.ugv": {"low": 0, "high": 10}},
