@@ -22,7 +22,8 @@ from astralis_des.registry import Registry
 ACTIONS: Registry[tuple[str, str], Any] = Registry("action", plugins=("astralis_des.actions",))
 # name -> strategy(agents, rooms, weights, ...) -> Assignment
 STRATEGIES: Registry[str, Any] = Registry("assignment strategy",
-                                          plugins=("astralis_des.assignment.strategies",))
+                                          plugins=("astralis_des.assignment.strategies",
+                                                   "astralis_des.assignment.baselines"))
 
 # fidelity -> co-simulation class (the physics one is imported only when asked for)
 COSIMS: Registry[str, Any] = Registry("fidelity", plugins=("astralis_des.cosim.kinematic",))

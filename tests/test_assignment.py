@@ -210,9 +210,9 @@ def test_greedy_takes_the_nearest_pair_first() -> None:
 def test_unknown_strategy_lists_valid_names() -> None:
     """An unknown strategy raises UnknownEntry listing the valid ones."""
     with pytest.raises(UnknownEntry) as info:
-        assign(AGENTS, ROOMS, PAPER, strategy="auction")
-    assert str(info.value) == ("unknown assignment strategy 'auction'; "
-                               "valid: greedy, mixed, naive")
+        assign(AGENTS, ROOMS, PAPER, strategy="bazaar")
+    assert str(info.value) == ("unknown assignment strategy 'bazaar'; "
+                               "valid: auction, cbba, greedy, hard, milp, mixed, naive, random")
 
 
 def test_misspelt_strategy_suggests_the_close_name() -> None:

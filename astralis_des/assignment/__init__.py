@@ -3,6 +3,7 @@
 Pure functions on plain data; the mission timeline calls them, and so can a study.
 """
 
+from astralis_des.assignment import baselines  # noqa: F401  (they register)
 from astralis_des.assignment.eq1 import Agent, RoomInfo, Weights, eq1_costs
 from astralis_des.assignment.matching import match
 from astralis_des.assignment.rules import table4_action

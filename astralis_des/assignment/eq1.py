@@ -24,6 +24,7 @@ class RoomInfo:
     position: tuple[float, float, float]
     risk: float
     messiness: float
+    area: float = 0.0  # m^2 of floor: what the queue planners' search times scale with
 
 
 @dataclass(frozen=True)

@@ -1,16 +1,20 @@
 """Assignment strategies by registry: ``mixed`` (Eq. 1 with W1, W2), ``naive`` (Eq. 1's
-distance alone) and ``greedy`` (nearest by travel time, one pair at a time)."""
+distance alone) and ``greedy`` (nearest by travel time, one pair at a time) give each agent at
+most one room a round; the baselines (:mod:`astralis_des.assignment.baselines`) plan whole
+queues (``auction``, ``cbba``, ``milp``) or match under other rules (``hard``, ``random``)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from astralis_des.assignment.eq1 import Agent, RoomInfo, Weights, distances, eq1_costs
 from astralis_des.assignment.matching import match
+from astralis_des.assignment.plans import Plan, Planner, Problem, queue_times
 from astralis_des.assignment.rules import table4_action
 from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.plugins import STRATEGIES as _STRATEGIES
@@ -30,8 +34,9 @@ class Assignment:
     agents: tuple[str, ...]
     rooms: tuple[str, ...]
     costs: NDArray[np.float64]
-    pairs: tuple[Pair, ...]
+    pairs: tuple[Pair, ...]  # each agent's in the order it searches them
     unassigned: tuple[str, ...]
+    info: dict[str, Any] = field(default_factory=dict)  # a planner's report on the round
 
     @property
     def total_cost(self) -> float:
@@ -47,13 +52,19 @@ Costs = Callable[[Sequence[Agent], Sequence[RoomInfo], Weights], NDArray[np.floa
 
 @dataclass(frozen=True)
 class Strategy:
-    """A cost matrix, and the matcher that pairs on it (None: the mission's solver)."""
+    """A cost matrix and the matcher that pairs on it (None: the mission's solver), or a
+    planner of whole queues; ``whole_mission``: it is given every pending room of the mission
+    at once, not a segment's."""
 
-    costs: Costs
+    costs: Costs | None = None
     matcher: str | None = None
+    planner: Planner | None = None
+    whole_mission: bool = False
 
     def __call__(self, agents: Sequence[Agent], rooms: Sequence[RoomInfo],
                  weights: Weights) -> NDArray[np.float64]:
+        if self.costs is None:  # a planner's matrix, for the record: Eq. 1's distance
+            return eq1_costs(agents, rooms, Weights.zero())
         return self.costs(agents, rooms, weights)
 
 
@@ -64,6 +75,14 @@ def register_strategy(name: str, matcher: str | None = None) -> Callable[[Costs]
     def add(costs: Costs) -> Costs:
         STRATEGIES.register(name)(Strategy(costs, matcher))
         return costs
+
+    return add
+
+
+def register_planner(name: str, *, whole_mission: bool = False) -> Callable[[Planner], Planner]:
+    def add(planner: Planner) -> Planner:
+        STRATEGIES.register(name)(Strategy(planner=planner, whole_mission=whole_mission))
+        return planner
 
     return add
 
@@ -94,14 +113,24 @@ def greedy(agents: Sequence[Agent], rooms: Sequence[RoomInfo],
 
 def assign(agents: Sequence[Agent], rooms: Sequence[RoomInfo], weights: Weights, *,
            strategy: str = "mixed", solver: str = "scipy", high_risk: float = 0.5,
-           high_messiness: float = 0.5,
-           reachable: NDArray[np.bool_] | None = None) -> Assignment:
-    """Match agents to rooms and pick each matched agent's action by Table IV.
+           high_messiness: float = 0.5, reachable: NDArray[np.bool_] | None = None,
+           rng: np.random.Generator | None = None,
+           options: Mapping[str, Any] | None = None) -> Assignment:
+    """Match agents to rooms (or plan their queues) and pick each action by Table IV.
 
     ``reachable[i, j]`` false excludes the edge: its cost is infinite, the matching avoids it,
-    and an agent left with only such edges stays unassigned (the room stays pending).
+    and an agent left with only such edges stays unassigned (the room stays pending). ``rng``
+    (the round's generator) and ``options`` (the mission's ``assignment.options``) are for
+    the strategies that draw or take parameters.
     """
     chosen = STRATEGIES.get(strategy)
+    if chosen.planner is not None:
+        allowed = np.ones((len(agents), len(rooms)), dtype=bool) if reachable is None \
+            else np.asarray(reachable, dtype=bool)
+        problem = Problem(agents, rooms, weights, allowed,
+                          rng if rng is not None else np.random.default_rng(0), high_risk,
+                          high_messiness, dict(options or {}))
+        return _planned(problem, chosen.planner(problem), chosen(agents, rooms, weights))
     costs = chosen(agents, rooms, weights)
     solver = chosen.matcher or solver
     if reachable is not None:
@@ -118,3 +147,16 @@ def assign(agents: Sequence[Agent], rooms: Sequence[RoomInfo], weights: Weights,
     matched = {p.agent for p in pairs}
     return Assignment(tuple(a.id for a in agents), tuple(r.id for r in rooms), costs, pairs,
                       tuple(a.id for a in agents if a.id not in matched))
+
+
+def _planned(problem: Problem, plan: Plan, costs: NDArray[np.float64]) -> Assignment:
+    """A planner's queues as pairs, each costing its estimated finish time from the start."""
+    agents, rooms = problem.agents, problem.rooms
+    pairs = []
+    for i, queue in enumerate(plan.queues):
+        for j, t in zip(queue, queue_times(problem, i, queue), strict=True):
+            pairs.append(Pair(agents[i].id, rooms[j].id, round(t, 6), problem.action(i, j)))
+    busy = {p.agent for p in pairs}
+    return Assignment(tuple(a.id for a in agents), tuple(r.id for r in rooms),
+                      np.where(problem.allowed, costs, np.inf), tuple(pairs),
+                      tuple(a.id for a in agents if a.id not in busy), plan.info)

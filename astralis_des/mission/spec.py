@@ -169,8 +169,25 @@ class WeightsSpec(Strict):
     messiness: KindWeights = KindWeights(human=5.0, uav=0.0, ugv=10.0)
 
 
+class StrategyOptions(Strict):
+    """Parameters of the baseline strategies (astralis_des.assignment.baselines)."""
+
+    bundle: int = Field(3, ge=1, le=100, description="cbba: rooms in an agent's bundle, at most")
+    comm_range: PositiveFloat | None = Field(
+        None, description="cbba: metres within which two agents talk; unset: all of them do")
+    discount: float = Field(0.99, gt=0, lt=1, description="cbba: reward kept per second")
+    bid: Literal["marginal", "finish"] = Field(
+        "marginal", description="auction: bid what the room adds to the queue, or the queue's "
+        "finish time with it")
+    objective: Literal["makespan", "sum"] = Field(
+        "makespan", description="milp: the latest finish, or the sum of completion times")
+    time_limit: PositiveFloat = Field(1.0, description="milp: s of solver time a round")
+    mip_gap: float = Field(1e-4, ge=0, le=1, description="milp: relative gap to stop at")
+
+
 class AssignmentSpec(Strict):
     strategy: str = "mixed"
+    options: StrategyOptions = Field(default_factory=StrategyOptions)
     weights: WeightsSpec = Field(default_factory=WeightsSpec)
     high_risk: Unit = 0.5
     high_messiness: Unit = 0.5

@@ -25,6 +25,7 @@ class Run(Host, Protocol):
     cosim: Any
     rooms: dict[str, RoomState]  # what the mission drew for each room
     rounds: list[dict[str, Any]]  # the assignment rounds so far
+    allocation_time: list[float]  # wall s of each round's assignment (not logged)
     searched: list[str]  # rooms searched, in order
     tried: dict[str, set[str]]  # room -> kinds whose search saw too little of it
     finished: list[tuple[Task, ActionResult]]

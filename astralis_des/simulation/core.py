@@ -64,6 +64,7 @@ class Simulation:
                                       stream(spec.seed, "sensing"))
         self.found = self.env.event()
         self.rounds: list[dict[str, Any]] = []
+        self.allocation_time: list[float] = []  # wall s of each round's assignment
         self.searched: list[str] = []
         self.tried: dict[str, set[str]] = {}  # room -> kinds whose search saw too little of it
         self.finished: list[tuple[Task, ActionResult]] = []
@@ -191,13 +192,17 @@ class Simulation:
         exclude = exclude or {}
         agents = [Agent(r.id, r.kind, _xyz(r.position(self.env.now))) for r in robots]
         infos = [RoomInfo(rid, self.world.rooms[rid].center, self.rooms[rid].risk,
-                          self.rooms[rid].messiness) for rid in rooms]
+                          self.rooms[rid].messiness, _floor_area(self.world.rooms[rid].box))
+                 for rid in rooms]
         weights = Weights(cfg.weights.risk.model_dump(), cfg.weights.messiness.model_dump())
         reachable = np.array([[robot.kind not in exclude.get(rid, ()) and
                                self._reaches(robot, rid) for rid in rooms] for robot in robots])
+        started = time.perf_counter()
         plan = assign(agents, infos, weights, strategy=cfg.strategy, solver=cfg.solver,
                       high_risk=cfg.high_risk, high_messiness=cfg.high_messiness,
-                      reachable=reachable)
+                      reachable=reachable, options=cfg.options.model_dump(),
+                      rng=stream(self.mission.spec.seed, "assignment", len(self.rounds) + 1))
+        self.allocation_time.append(time.perf_counter() - started)  # wall: not in the log
         record: dict[str, Any] = {
             "round": len(self.rounds) + 1, "t": self.env.now, "segment": segment,
             "strategy": cfg.strategy, "agents": list(plan.agents), "rooms": list(plan.rooms),
@@ -207,6 +212,8 @@ class Simulation:
                          for p in plan.pairs],
             "unassigned": list(plan.unassigned),
         }
+        if plan.info:  # a planner's report (the paper's strategies have none)
+            record["info"] = plan.info
         self.rounds.append(record)
         self.log.emit("assignment", **{k: v for k, v in record.items() if k != "t"})
         return plan
@@ -321,3 +328,9 @@ def view_of(member: MemberSpec) -> View | None:
 
 def _xyz(p: np.ndarray) -> tuple[float, float, float]:
     return (float(p[0]), float(p[1]), float(p[2]))
+
+
+def _floor_area(box: Any) -> float:
+    """m^2 of a room's floor (its box's footprint)."""
+    size = box.size
+    return float(size[0] * size[1])

@@ -46,6 +46,7 @@ class RunResult:
     sensor_calls: dict[str, int] = field(default_factory=dict)  # physics: looks, renders, scans
     wall_time: float = 0.0
     sensor_time: dict[str, float] = field(default_factory=dict)  # wall s per sensor (physics)
+    allocation_time: list[float] = field(default_factory=list)  # wall s of each round's plan
 
     @property
     def found(self) -> bool:
@@ -61,6 +62,7 @@ class RunResult:
         data.pop("events")
         data.pop("wall_time")
         data.pop("sensor_time")
+        data.pop("allocation_time")
         summary: dict[str, Any] = plain(data)
         return summary
 
@@ -89,7 +91,8 @@ def build_result(sim: Run, outcome: str, wall_time: float) -> RunResult:
         rounds=sim.rounds, rooms_searched=list(sim.searched), coverage=coverage,
         events=sim.log.records, rooms=rooms, wall_time=wall_time,
         sensor_calls=dict(sorted(clock.calls.items())) if clock else {},
-        sensor_time=dict(sorted(clock.seconds.items())) if clock else {})
+        sensor_time=dict(sorted(clock.seconds.items())) if clock else {},
+        allocation_time=list(sim.allocation_time))
 
 
 def room_report(sim: Run) -> dict[str, dict[str, Any]]:

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any, cast
 
 import simpy
 
+from astralis_des.assignment import STRATEGIES
 from astralis_des.kernel.tasks import ActionResult
 from astralis_des.mission.spec import (
     CancelEvent,
@@ -40,8 +41,8 @@ def search(sim: Run) -> Generator[simpy.Event, Any, str]:
     spec = sim.mission.spec.assignment
     if spec.start_at > 0:
         yield sim.env.timeout(spec.start_at)
-    for segment in sim.mission.searched_segments():
-        pending = list(sim.world.segments[segment].rooms)
+    for segment, rooms in _groups(sim):
+        pending = list(rooms)
         while pending:
             agents = [r for r in sim.robots.values() if not r.faulted]
             if not agents:
@@ -70,6 +71,15 @@ def search(sim: Run) -> Generator[simpy.Event, Any, str]:
                     pending.remove(room)
                     sim.log.emit("room_given_up", room=room, attempts=attempts[room])
     return "not_found"
+
+
+def _groups(sim: Run) -> list[tuple[str, list[str]]]:
+    """The rooms a round is given: a segment's at a time, as the paper's rounds do, or every
+    searched room at once (``all``) for a strategy that plans whole queues."""
+    segments = sim.mission.searched_segments()
+    if STRATEGIES.get(sim.mission.spec.assignment.strategy).whole_mission:
+        return [("all", [r for seg in segments for r in sim.world.segments[seg].rooms])]
+    return [(seg, list(sim.world.segments[seg].rooms)) for seg in segments]
 
 
 def _undercovered(sim: Run, room: str, robot: Any, outcome: ActionResult) -> bool:

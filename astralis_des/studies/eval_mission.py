@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 from astralis_des.kinds import KINDS
 from astralis_des.studies.eval_assignment import team_ids
+from astralis_des.studies.eval_metrics import allocation_metrics
 from astralis_des.studies.evaluation import Metric, evaluation
 
 if TYPE_CHECKING:
@@ -28,6 +29,14 @@ METRICS = (
     Metric("ugv_high_mess_s", "UGV searching high-messiness rooms", "mean", "s"),
     Metric("rooms_searched", "rooms searched", "mean"),
     Metric("distance", "distance (team)", "mean", "m"),
+    Metric("makespan", "makespan (last search ends)", "mean", "s"),
+    Metric("completion_sum", "sum of completion times", "mean", "s"),
+    Metric("infeasible_rounds", "infeasible rounds", "mean"),
+    Metric("workload_gini", "workload Gini (rooms per robot)", "mean"),
+    Metric("human_high_risk_rounds", "rounds: human to a high-risk room", "mean"),
+    Metric("ugv_high_mess_rounds", "rounds: UGV to a high-messiness room", "mean"),
+    Metric("human_min_distance", "closest moving robot to the human", "mean", "m"),
+    Metric("human_close_s", "human within 1.2 m of a moving robot", "mean", "s"),
 )
 
 
@@ -79,6 +88,7 @@ def evaluate_mission(study: Study, scenario: Scenario, variant: Variant,
     row["ugv_high_mess_s"] = search_time(sim, "ugv", high_mess)
     row["high_risk_rooms"] = len(high_risk)
     row["high_mess_rooms"] = len(high_mess)
+    row.update(allocation_metrics(sim, result, s.high_risk, s.high_messiness))
     return row
 
 

@@ -77,7 +77,7 @@ def summarize(table: pa.Table, metrics: Sequence[Metric],
     data = table.to_pydict()
     out = []
     for variant in variants:
-        mine = [i for i, v in enumerate(data["variant"]) if v == variant]
+        mine = [i for i, v in enumerate(data.get("variant", [])) if v == variant]
         ok = [i for i in mine if data["status"][i] == "ok"]
         for metric in metrics:
             values = [data[metric.column][i] for i in ok] if metric.column in data else []

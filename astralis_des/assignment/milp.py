@@ -1,0 +1,171 @@
+"""``milp``: a time-limited mixed-integer program over every pending room of the mission
+(Sadcher's and MRTA-Benchmark's MILP baseline), solved by HiGHS through
+``scipy.optimize.milp``.
+
+The rooms go to the agents that may take them, each room to one agent, all of them searched.
+An agent's work is the Table IV search of each of its rooms (:mod:`.durations`) and the leg
+into each from that room's nearest pending neighbour (an estimate of a chain through nearby
+rooms: the program assigns, it does not route), and for a busy agent the way from where it
+stands to the nearest pending room. ``options.objective``:
+
+- ``makespan`` (default): minimise the latest agent's finish (unrelated parallel machines,
+  R||Cmax, with a binary per agent for the first leg).
+- ``sum``: minimise the sum of the rooms' completion times: room ``j`` in the ``r``-th place
+  from the end of agent ``i``'s queue adds ``r`` times its duration (the classic
+  position-indexed program for unrelated machines).
+
+It reports the solver's relative gap, whether it hit ``options.time_limit`` (default 1 s of
+solver time) and its status; a round that hits the limit takes the best plan found, and may then
+differ from one machine to another. Each queue is ordered as a chain: the agent's room nearest
+to it first, then the nearest of its rooms left.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy.optimize import Bounds, LinearConstraint, milp
+
+from astralis_des.assignment.plans import Plan, Problem
+from astralis_des.assignment.strategies import register_planner
+
+
+def _durations(problem: Problem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(A, R)`` search seconds, the first leg from the start, and the hop into each room
+    from its nearest other pending room."""
+    n_a, n_r = problem.allowed.shape
+    search = np.array([[problem.search(i, j) for j in range(n_r)] for i in range(n_a)])
+    first = np.array([problem.travel_from(i, problem.start(i)) for i in range(n_a)])
+    hop = np.zeros((n_a, n_r))
+    for i in range(n_a):
+        legs = np.array([problem.travel_from(i, p) for p in problem.room_points])
+        np.fill_diagonal(legs, np.inf)
+        hop[i] = legs.min(axis=0) if n_r > 1 else 0.0
+    return search, first, hop
+
+
+def _makespan(problem: Problem, search: np.ndarray, first: np.ndarray,
+              hop: np.ndarray) -> tuple[Any, list[tuple[int, int]], np.ndarray]:
+    """Unrelated parallel machines, latest finish (R||Cmax) with a busy agent's first leg."""
+    n_a, n_r = problem.allowed.shape
+    edges = [(i, j) for i in range(n_a) for j in range(n_r) if problem.allowed[i, j]]
+    e = len(edges)
+    n = e + n_a + 1  # x per edge, busy per agent, T
+    lead = np.array([max(0.0, float(np.min(first[i] - hop[i]))) if n_r else 0.0
+                     for i in range(n_a)])  # into the nearest room, beyond its hop
+    cost = np.zeros(n)
+    cost[-1] = 1.0
+    rows: list[np.ndarray] = []
+    lo: list[float] = []
+    hi: list[float] = []
+
+    def row(low: float, high: float) -> np.ndarray:
+        r = np.zeros(n)
+        rows.append(r)
+        lo.append(low)
+        hi.append(high)
+        return r
+
+    for j in range(n_r):  # each room once, if anyone may take it
+        ks = [k for k, (_, jj) in enumerate(edges) if jj == j]
+        if ks:
+            row(1.0, 1.0)[ks] = 1.0
+    for i in range(n_a):
+        ks = [k for k, (ii, _) in enumerate(edges) if ii == i]
+        work = row(-np.inf, 0.0)  # work - T <= 0
+        for k in ks:
+            work[k] = search[i, edges[k][1]] + hop[i, edges[k][1]]
+        work[e + i], work[-1] = lead[i], -1.0
+        for k in ks:  # busy once it has a room
+            busy = row(-np.inf, 0.0)
+            busy[k], busy[e + i] = 1.0, -1.0
+    integrality = np.ones(n)
+    integrality[-1] = 0
+    upper = np.ones(n)
+    upper[-1] = np.inf
+    result = milp(cost, constraints=LinearConstraint(np.array(rows), lo, hi),
+                  integrality=integrality, bounds=Bounds(np.zeros(n), upper),
+                  options=_options(problem))
+    chosen = [] if result.x is None else [edges[k] for k in range(e) if result.x[k] > 0.5]
+    return result, chosen, _firsts(n_a, n_r, chosen, first)
+
+
+def _sum(problem: Problem, search: np.ndarray, hop: np.ndarray,
+         first: np.ndarray) -> tuple[Any, list[tuple[int, int]], np.ndarray]:
+    n_a, n_r = problem.allowed.shape
+    slots = [(i, j, r) for i in range(n_a) for j in range(n_r) for r in range(1, n_r + 1)
+             if problem.allowed[i, j]]
+    n = len(slots)
+    cost = np.array([r * (search[i, j] + hop[i, j]) for i, j, r in slots])
+    rows, lo, hi = [], [], []
+    for j in range(n_r):
+        ks = [k for k, s in enumerate(slots) if s[1] == j]
+        if ks:
+            r = np.zeros(n)
+            r[ks] = 1.0
+            rows.append(r)
+            lo.append(1.0)
+            hi.append(1.0)
+    for i in range(n_a):
+        for place in range(1, n_r + 1):
+            ks = [k for k, s in enumerate(slots) if s[0] == i and s[2] == place]
+            if ks:
+                r = np.zeros(n)
+                r[ks] = 1.0
+                rows.append(r)
+                lo.append(-np.inf)
+                hi.append(1.0)
+    result = milp(cost, constraints=LinearConstraint(np.array(rows), lo, hi),
+                  integrality=np.ones(n), bounds=Bounds(np.zeros(n), np.ones(n)),
+                  options=_options(problem))
+    chosen = [] if result.x is None else [slots[k] for k in range(n) if result.x[k] > 0.5]
+    pairs = [(i, j) for i, j, _ in chosen]
+    return result, pairs, _firsts(n_a, n_r, pairs, first)
+
+
+def _firsts(n_a: int, n_r: int, pairs: list[tuple[int, int]], first: np.ndarray) -> np.ndarray:
+    """Each busy agent's first room: the one of its rooms nearest to where it stands."""
+    f = np.zeros((n_a, n_r))
+    for i in range(n_a):
+        mine = [j for ii, j in pairs if ii == i]
+        if mine:
+            f[i, min(mine, key=lambda j: (first[i, j], j))] = 1.0
+    return f
+
+
+def _options(problem: Problem) -> dict[str, Any]:
+    return {"time_limit": float(problem.options.get("time_limit", 1.0)),
+            "mip_rel_gap": float(problem.options.get("mip_gap", 1e-4)), "disp": False}
+
+
+@register_planner("milp", whole_mission=True)
+def milp_plan(problem: Problem) -> Plan:
+    objective = str(problem.options.get("objective", "makespan"))
+    search, first, hop = _durations(problem)
+    if objective == "sum":
+        result, pairs, f = _sum(problem, search, hop, first)
+    else:
+        result, pairs, f = _makespan(problem, search, first, hop)
+    queues = [_chain(problem, i, [j for ii, j in pairs if ii == i], f[i])
+              for i in range(problem.allowed.shape[0])]
+    gap = getattr(result, "mip_gap", None)
+    info = {"objective": objective, "status": int(result.status),
+            "hit_limit": int(result.status) == 1,
+            "gap": None if gap is None or not np.isfinite(gap) else round(float(gap), 6),
+            "value": None if result.fun is None else round(float(result.fun), 6)}
+    return Plan(queues, info)
+
+
+def _chain(problem: Problem, i: int, rooms: list[int], first: np.ndarray) -> list[int]:
+    """Agent ``i``'s rooms in order: its first room, then the nearest of those left."""
+    if not rooms:
+        return []
+    start = max(rooms, key=lambda j: (first[j], -j))
+    order, left = [start], [j for j in rooms if j != start]
+    while left:
+        legs = problem.travel_from(i, problem.room_points[order[-1]])
+        nxt = min(left, key=lambda j: (legs[j], j))
+        order.append(nxt)
+        left.remove(nxt)
+    return order

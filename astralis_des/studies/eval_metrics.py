@@ -1,0 +1,122 @@
+"""The metrics of the multi-robot task allocation field, from a finished mission (issue 21).
+
+- ``makespan``: when the last search of the run ended (a mission stops when the target is
+  seen, so this is the makespan of what was executed, not of the whole plan);
+  ``completion_sum``: the sum of the end times of the rooms searched (Sadcher's and
+  MRTA-Benchmark's two objectives, on executed searches);
+- ``infeasible_rounds``: rounds a planner reported infeasible (``hard``);
+- ``rooms_per_robot`` and ``workload_gini``: rooms each robot searched, and the Gini
+  coefficient of those counts over the team (0: even; near 1: one robot did all);
+- ``human_high_risk_rounds`` and ``ugv_high_mess_rounds``: the share of rounds that gave a
+  person a high-risk room, or the UGV a high-messiness room (Table V's violations, per round);
+- ``human_min_distance`` and ``human_close_s``: the closest a moving robot came to a person,
+  and the seconds a person spent within ``CLOSE`` metres of one (HuNavSim's social metrics),
+  from the robots' trails sampled every ``STEP`` seconds.
+
+A round's wall compute time is no column (the table stays the same byte for byte on any
+machine): ``RunResult.allocation_time`` holds it per round, and
+``tools/bench/bench_allocation.py`` measures it per strategy.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from astralis_des.simulation import Simulation
+    from astralis_des.simulation.result import RunResult
+
+CLOSE = 1.2  # m: a robot this near a person is too near (HuNavSim)
+STEP = 0.1  # s between the samples of the trails
+MOVING = 0.05  # m/s: slower is standing still
+
+
+def allocation_metrics(sim: Simulation, result: RunResult, high_risk: float,
+                       high_messiness: float) -> dict[str, Any]:
+    searches = [(task, res) for task, res in sim.finished
+                if task.room and task.action != "move" and res.ok]
+    ends = {task.room: res.end for task, res in searches}
+    counts = np.array([sum(1 for task, _ in searches if task.robot == rid)
+                       for rid in sim.robots], dtype=float)
+    human, ugv = _round_shares(sim, result.rounds, high_risk, high_messiness)
+    return {
+        "makespan": max((res.end for _, res in searches), default=None),
+        "completion_sum": float(sum(ends.values())) if ends else None,
+        "infeasible_rounds": sum(1 for r in result.rounds if r.get("info", {}).get("infeasible")),
+        "rooms_per_robot": float(counts.mean()) if len(counts) else 0.0,
+        "workload_gini": gini(counts),
+        "human_high_risk_rounds": human,
+        "ugv_high_mess_rounds": ugv,
+        **social(sim, result.end_time),
+    }
+
+
+def gini(values: np.ndarray) -> float:
+    """The Gini coefficient of non-negative ``values`` (0 when all are equal or all zero)."""
+    v = np.sort(np.asarray(values, dtype=float))
+    n, total = len(v), float(v.sum())
+    if n == 0 or total == 0:
+        return 0.0
+    ranks = np.arange(1, n + 1)
+    return float((2 * (ranks * v).sum()) / (n * total) - (n + 1) / n)
+
+
+def _round_shares(sim: Simulation, rounds: list[dict[str, Any]], high_risk: float,
+                  high_messiness: float) -> tuple[float | None, float | None]:
+    """Shares of the rounds with a person in a high-risk room, a UGV in a high-messiness one
+    (None where the team has no such agent or there were no rounds)."""
+    kinds = {rid: r.kind for rid, r in sim.robots.items()}
+    shares: list[float | None] = []
+    for kind, column, threshold in (("human", "risk", high_risk),
+                                    ("ugv", "messiness", high_messiness)):
+        if kind not in kinds.values() or not rounds:
+            shares.append(None)
+            continue
+        bad = 0
+        for record in rounds:
+            value = dict(zip(record["rooms"], record[column], strict=True))
+            bad += any(kinds.get(p["agent"]) == kind and value[p["room"]] >= threshold
+                       for p in record["matching"])
+        shares.append(bad / len(rounds))
+    return shares[0], shares[1]
+
+
+def social(sim: Simulation, end: float) -> dict[str, float | None]:
+    """The closest approach of a moving robot to a person, and seconds within ``CLOSE``."""
+    people = [rid for rid, r in sim.robots.items() if r.kind == "human"]
+    others = [rid for rid, r in sim.robots.items() if r.kind != "human"]
+    if not people or not others or end <= 0:
+        return {"human_min_distance": None, "human_close_s": None}
+    times = np.arange(0.0, end + STEP / 2, STEP)
+    where = {rid: _track(sim, rid, times, end) for rid in sim.robots}
+    nearest, close = np.inf, 0.0
+    for person in people:
+        near = np.full(len(times), np.inf)
+        for rid in others:
+            path = where[rid]
+            speed = np.linalg.norm(np.gradient(path, STEP, axis=0), axis=1)
+            gap = np.linalg.norm(path - where[person], axis=1)
+            near = np.minimum(near, np.where(speed > MOVING, gap, np.inf))
+        nearest = min(nearest, float(near.min()))
+        close += float((near < CLOSE).sum() * STEP)
+    return {"human_min_distance": nearest if np.isfinite(nearest) else None,
+            "human_close_s": close}
+
+
+def _track(sim: Simulation, rid: str, times: np.ndarray, end: float) -> np.ndarray:
+    """Where robot ``rid`` was at ``times``, from its trail (and a motion still under way)."""
+    robot = sim.robots[rid]
+    t = list(robot.trail_t)
+    p = [np.asarray(q, dtype=float) for q in robot.trail_p]
+    if robot.motion is not None:
+        more_t, more_p = robot.motion.vertices_until(end)
+        t += more_t.tolist()
+        p += list(more_p)
+    if not t:
+        return np.repeat(np.asarray(robot.pose, dtype=float)[None, :], len(times), axis=0)
+    tt, pp = np.asarray(t), np.asarray(p)
+    order = np.argsort(tt, kind="stable")
+    tt, pp = tt[order], pp[order]
+    return np.column_stack([np.interp(times, tt, pp[:, k]) for k in range(3)])
