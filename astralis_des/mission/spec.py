@@ -182,7 +182,7 @@ class StrategyOptions(Strict):
     objective: Literal["makespan", "sum"] = Field(
         "makespan", description="milp: the latest finish, or the sum of completion times")
     time_limit: PositiveFloat = Field(1.0, description="milp: s of solver time a round")
-    mip_gap: float = Field(1e-4, ge=0, le=1, description="milp: relative gap to stop at")
+    mip_gap: float = Field(0.01, ge=0, le=1, description="milp: relative gap to stop at")
 
 
 class AssignmentSpec(Strict):

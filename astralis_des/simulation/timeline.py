@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable, Generator
+from functools import partial
 from typing import TYPE_CHECKING, Any, cast
 
 import simpy
@@ -25,6 +26,7 @@ if TYPE_CHECKING:
 
 Handler = Callable[["Run", Any], None]
 TIMELINE_EVENTS: Registry[str, Handler] = Registry("timeline event")
+ALL = "all"  # the segment of a round given every searched room
 
 
 def search(sim: Run) -> Generator[simpy.Event, Any, str]:
@@ -55,22 +57,45 @@ def search(sim: Run) -> Generator[simpy.Event, Any, str]:
                     pending.remove(room)
                 break
             searches = dispatch(sim, plan)
-            yield simpy.AllOf(sim.env, list(searches.values()))
             searcher = {p.room: p.agent for p in plan.pairs}
-            for room, done in searches.items():
-                outcome = cast(ActionResult, done.value)
-                robot = sim.robots[searcher[room]]
-                if outcome.ok and not _undercovered(sim, room, robot, outcome):
-                    pending.remove(room)
-                    sim.searched.append(room)
-                    continue
-                if outcome.ok or robot.faulted:
-                    continue  # seen too little, or the robot broke: another takes it next round
-                attempts[room] += 1
-                if attempts[room] >= spec.max_attempts:
-                    pending.remove(room)
-                    sim.log.emit("room_given_up", room=room, attempts=attempts[room])
+            yield from _as_they_end(sim, searches, segment == ALL,
+                                    partial(_book, sim, pending, attempts, searcher))
     return "not_found"
+
+
+def _book(sim: Run, pending: list[str], attempts: Counter[str], searcher: dict[str, str],
+          room: str, done: simpy.Event) -> None:
+    """A search that ended: its room searched, left pending for another kind (seen too
+    little) or another robot (its own broke down), or tried once more, up to the limit."""
+    outcome = cast(ActionResult, done.value)
+    robot = sim.robots[searcher[room]]
+    if outcome.ok and not _undercovered(sim, room, robot, outcome):
+        pending.remove(room)
+        sim.searched.append(room)
+        return
+    if outcome.ok or robot.faulted:
+        return  # seen too little, or the robot broke: another takes it next round
+    attempts[room] += 1
+    if attempts[room] >= sim.mission.spec.assignment.max_attempts:
+        pending.remove(room)
+        sim.log.emit("room_given_up", room=room, attempts=attempts[room])
+
+
+def _as_they_end(sim: Run, searches: dict[str, simpy.Event], one_by_one: bool,
+                 book: Callable[[str, simpy.Event], None]) -> Generator[simpy.Event, Any, None]:
+    """Book the round's searches: all together once they have ended (a segment's round), or
+    each as it ends (whole queues: a room counts as searched as soon as it is, not when the
+    last queue runs dry, which a found target may never let happen)."""
+    if not one_by_one:
+        yield simpy.AllOf(sim.env, list(searches.values()))
+        for room, done in searches.items():
+            book(room, done)
+        return
+    left = dict(searches)
+    while left:
+        yield simpy.AnyOf(sim.env, list(left.values()))
+        for room in [r for r, e in left.items() if e.processed]:
+            book(room, left.pop(room))
 
 
 def _groups(sim: Run) -> list[tuple[str, list[str]]]:
@@ -78,7 +103,7 @@ def _groups(sim: Run) -> list[tuple[str, list[str]]]:
     searched room at once (``all``) for a strategy that plans whole queues."""
     segments = sim.mission.searched_segments()
     if STRATEGIES.get(sim.mission.spec.assignment.strategy).whole_mission:
-        return [("all", [r for seg in segments for r in sim.world.segments[seg].rooms])]
+        return [(ALL, [r for seg in segments for r in sim.world.segments[seg].rooms])]
     return [(seg, list(sim.world.segments[seg].rooms)) for seg in segments]
 
 
