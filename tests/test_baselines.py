@@ -216,3 +216,19 @@ def test_allocation_metrics_of_the_default_mission_match_its_event_log(tmp_path:
                     for p in r["matching"]) for r in rounds)
     assert got["human_high_risk_rounds"] == pytest.approx(human / len(rounds))
     assert got["infeasible_rounds"] == 0
+
+
+def test_a_study_varies_the_baselines_options(tmp_path: Path) -> None:
+    """``options`` is a study parameter: CBBA with bundles of one room against three."""
+    from astralis_des.studies import make_study, run_study
+
+    study = make_study(ROOT / "missions" / "urban_search.yaml", name="bundles", scenarios=2,
+                       seed=3, evaluate="mission",
+                       set={"strategy": "cbba", "fidelity": "kinematic"},
+                       vary={"options": [{"bundle": 1}, {"bundle": 3}]})
+    rows = run_study(study, workers=1).rows
+    assert [r["variant"] for r in rows] == ["bundle=1", "bundle=3"] * 2
+    assert all(r["status"] == "ok" for r in rows)
+    one = [r for r in rows if "bundle=1" in r["variant"]]
+    three = [r for r in rows if "bundle=3" in r["variant"]]
+    assert [r["rounds"] for r in one] != [r["rounds"] for r in three]  # more rounds of 1 room

@@ -22,10 +22,15 @@ to it first, then the nearest of its rooms left.
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
-from scipy.optimize import Bounds, LinearConstraint, milp
+from scipy.optimize import Bounds, LinearConstraint
+from scipy.optimize import milp as _highs_milp
 
 from astralis_des.assignment.plans import Plan, Problem
 from astralis_des.assignment.strategies import register_planner
@@ -86,7 +91,7 @@ def _makespan(problem: Problem, search: np.ndarray, first: np.ndarray,
     integrality[-1] = 0
     upper = np.ones(n)
     upper[-1] = np.inf
-    result = milp(cost, constraints=LinearConstraint(np.array(rows), lo, hi),
+    result = _solve(cost, constraints=LinearConstraint(np.array(rows), lo, hi),
                   integrality=integrality, bounds=Bounds(np.zeros(n), upper),
                   options=_options(problem))
     chosen = [] if result.x is None else [edges[k] for k in range(e) if result.x[k] > 0.5]
@@ -118,7 +123,7 @@ def _sum(problem: Problem, search: np.ndarray, hop: np.ndarray,
                 rows.append(r)
                 lo.append(-np.inf)
                 hi.append(1.0)
-    result = milp(cost, constraints=LinearConstraint(np.array(rows), lo, hi),
+    result = _solve(cost, constraints=LinearConstraint(np.array(rows), lo, hi),
                   integrality=np.ones(n), bounds=Bounds(np.zeros(n), np.ones(n)),
                   options=_options(problem))
     chosen = [] if result.x is None else [slots[k] for k in range(n) if result.x[k] > 0.5]
@@ -134,6 +139,36 @@ def _firsts(n_a: int, n_r: int, pairs: list[tuple[int, int]], first: np.ndarray)
         if mine:
             f[i, min(mine, key=lambda j: (first[i, j], j))] = 1.0
     return f
+
+
+@contextlib.contextmanager
+def _quiet() -> Iterator[None]:
+    """Stdout and stderr of the process closed for the solve: HiGHS 1.x prints
+    ``transformNewIntegerFeasibleSolution tmpSolver.run();`` from C++ whatever its output
+    settings (ERGO-Code/HiGHS#2783, fixed after the version SciPy 1.17 bundles)."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    try:
+        saved = [os.dup(1), os.dup(2)]
+    except OSError:  # no such descriptors (an embedded interpreter): nothing to hide
+        yield
+        return
+    null = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 1)
+        os.dup2(null, 2)
+        yield
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in (*saved, null):
+            os.close(fd)
+
+
+def _solve(*args: Any, **kwargs: Any) -> Any:
+    with _quiet():
+        return _highs_milp(*args, **kwargs)
 
 
 def _options(problem: Problem) -> dict[str, Any]:

@@ -184,6 +184,11 @@ class StrategyOptions(Strict):
     time_limit: PositiveFloat = Field(1.0, description="milp: s of solver time a round")
     mip_gap: float = Field(0.01, ge=0, le=1, description="milp: relative gap to stop at")
 
+    def label(self) -> str:
+        """How a study names a variant with these options: what was set, ``bundle=1``."""
+        return ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
+                         for k, v in self.model_dump(exclude_unset=True).items()) or "defaults"
+
 
 class AssignmentSpec(Strict):
     strategy: str = "mixed"

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 from astralis_des.assignment import Agent, RoomInfo, Weights, assign
 from astralis_des.kinds import KINDS
+from astralis_des.streams import stream
 from astralis_des.studies.evaluation import Metric, evaluation
 
 if TYPE_CHECKING:
@@ -39,10 +40,13 @@ def evaluate_assignment(study: Study, scenario: Scenario, variant: Variant,
     values = scenario.values(s.risk, s.messiness)
     agents = [Agent(ident, kind, _where(study, scenario.start(kind, k)))
               for ident, kind, k in team_ids(s.team)]
-    rooms = [RoomInfo(r, world.rooms[r].center, *values[r]) for r in room_ids]
+    rooms = [RoomInfo(r, world.rooms[r].center, *values[r],
+                      world.rooms[r].box.size[0] * world.rooms[r].box.size[1])
+             for r in room_ids]
     plan = assign(agents, rooms, Weights(s.weights["risk"], s.weights["messiness"]),
                   strategy=s.strategy, solver=study.mission.spec.assignment.solver,
-                  high_risk=s.high_risk, high_messiness=s.high_messiness)
+                  high_risk=s.high_risk, high_messiness=s.high_messiness,
+                  rng=stream(scenario.seed, "assignment", 1), options=s.options)
     kind_of = {a.id: a.kind for a in agents}
     high_risk = {r.id for r in rooms if r.risk >= s.high_risk}
     high_mess = {r.id for r in rooms if r.messiness >= s.high_messiness}

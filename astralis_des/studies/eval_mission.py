@@ -56,7 +56,7 @@ def scenario_mission(study: Study, scenario: Scenario, s: Setting, outputs: bool
         rooms["set"][room] = {**rooms["set"].get(room, {}), "risk": risk, "messiness": mess}
     assignment = base.assignment.model_dump(mode="json")
     assignment.update(strategy=s.strategy, weights=s.weights, high_risk=s.high_risk,
-                      high_messiness=s.high_messiness)
+                      high_messiness=s.high_messiness, options=s.options)
     return study.mission.with_changes(
         seed=scenario.seed, fidelity=s.fidelity, time_limit=s.time_limit, team=team,
         rooms=rooms, assignment=assignment,

@@ -9,13 +9,20 @@ a :class:`Setting`, everything a variant decides about how a scenario is run.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, Field, TypeAdapter, model_validator
 
 from astralis_des.kinds import KINDS
-from astralis_des.mission.spec import NonNegativeFloat, PositiveFloat, Strict, Unit, WeightsSpec
+from astralis_des.mission.spec import (
+    NonNegativeFloat,
+    PositiveFloat,
+    StrategyOptions,
+    Strict,
+    Unit,
+    WeightsSpec,
+)
 from astralis_des.registry import Registry, UnknownEntry
 from astralis_des.studies.draws import Dist, Uniform
 
@@ -36,6 +43,7 @@ class Setting:
     high_risk: float
     high_messiness: float
     time_limit: float
+    options: dict[str, Any] = field(default_factory=dict)  # the baselines' (assignment.options)
 
 
 @dataclass(frozen=True)
@@ -87,8 +95,14 @@ class TeamMix(Strict):
 
 @factor("strategy", Annotated[str, AfterValidator(_known_strategy)])
 def _strategy(s: Setting, value: str) -> Setting:
-    """the assignment strategy (mixed, naive, greedy)"""
+    """the assignment strategy (mixed, naive, greedy, hard, random, auction, cbba, milp)"""
     return replace(s, strategy=value)
+
+
+@factor("options", StrategyOptions)
+def _options(s: Setting, value: StrategyOptions) -> Setting:
+    """the baselines' parameters: {bundle, comm_range, discount, bid, objective, ...}"""
+    return replace(s, options=value.model_dump())
 
 
 @factor("weights", WeightsSpec)
@@ -158,13 +172,17 @@ def base_setting(mission: Any, risk: Any = None, messiness: Any = None) -> Setti
     return Setting(cfg.strategy, {"risk": cfg.weights.risk.model_dump(),
                                   "messiness": cfg.weights.messiness.model_dump()},
                    team, risk or Uniform(), messiness or Uniform(), spec.fidelity,
-                   cfg.high_risk, cfg.high_messiness, spec.time_limit)
+                   cfg.high_risk, cfg.high_messiness, spec.time_limit,
+                   cfg.options.model_dump())
 
 
 def label(value: Any) -> str:
     """How a value reads in a variant's name: ``0.5``, ``naive``, ``beta(a=2, b=5)``."""
     if isinstance(value, float):
         return f"{value:g}"
+    named = getattr(value, "label", None)
+    if isinstance(value, BaseModel) and callable(named):
+        return str(named())  # the model says how it reads
     if isinstance(value, BaseModel):
         data = value.model_dump(exclude_defaults=False)
         head = data.pop("dist", None) or data.pop("type", None) or ""
