@@ -10,6 +10,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 # what any site holds (1,000 km), so arithmetic on it cannot overflow.
 Finite = Annotated[float, Field(allow_inf_nan=False, ge=-1e6, le=1e6)]
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+MAX_SPEED = 100.0  # m/s: faster than any robot of a search team (a speed of 1e308 overflowed)
 NonNegativeFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 Vec3 = tuple[Finite, Finite, Finite]
 Kind = Literal["uav", "ugv", "human"]
@@ -94,7 +95,8 @@ class MemberSpec(Strict):
     id: str = Field(pattern=r"^[A-Za-z][A-Za-z0-9_-]*$")
     kind: Kind
     start: Vec3 | str = Field(description="[x, y, z] in metres, or a room id")
-    speed: PositiveFloat | None = Field(None, description="m/s; default by kind")
+    speed: PositiveFloat | None = Field(None, le=MAX_SPEED,
+                                        description="m/s; default by kind")
     height: PositiveFloat | None = Field(
         None, description="m above the floor of its sensor (UAV: flight altitude)")
     sensors: SensorsSpec | None = Field(None, description="default: the kind's sensor set")
@@ -324,7 +326,7 @@ class SceneSpec(Strict):
     clutter: bool = True
     catalogue: str | None = Field(None, description="catalogue file, relative to the mission")
     movers: int = Field(0, ge=0, le=100, description="moving obstacles in corridors")
-    mover_speed: PositiveFloat = 0.6
+    mover_speed: PositiveFloat = Field(0.6, le=MAX_SPEED, description="m/s")
 
 
 class OutputsSpec(Strict):
