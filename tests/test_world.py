@@ -130,3 +130,13 @@ def test_a_world_of_too_many_rooms_is_refused_at_once(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"w.yaml:\d+: buildings\[0\]: building t has "
                                          r"200,208 rooms; a world holds at most 10,000"):
         load_world(path)
+
+
+def test_buildings_under_the_room_bound_each_are_refused_together(tmp_path: Path) -> None:
+    path = tmp_path / "w.yaml"
+    building = "{id: %s, origin: [%d, 1], floors: 10, segments: [{side: south, rooms: 600}]}"
+    path.write_text("name: w\nsite: {size: [9000, 100]}\nbuildings:\n" + "".join(
+        f"  - {building % (b, 1 + 3000 * k)}\n" for k, b in enumerate("ab")), encoding="utf-8")
+    with pytest.raises(InputError, match=r"w.yaml:\d+: buildings: the buildings have 12,000 "
+                                         r"rooms; a world holds at most 10,000"):
+        load_world(path)

@@ -165,6 +165,10 @@ class WorldSpec(Strict):
         ids = [b.id for b in buildings]
         if len(ids) != len(set(ids)):
             raise ValueError(f"building ids must be unique, got {ids}")
+        rooms = sum(b.floors * sum(s.rooms for s in b.segments) for b in buildings)
+        if rooms > MAX_ROOMS:  # each building may be under the bound, all of them not
+            raise ValueError(f"the buildings have {rooms:,} rooms; a world holds at most "
+                             f"{MAX_ROOMS:,}")
         return buildings
 
     @model_validator(mode="after")
