@@ -112,13 +112,13 @@ class GeometricSensor:
         view = robot.view
         pts, heads = _sample_path(robot, np.asarray(points, dtype=float), headings)
         size = np.asarray(self.target.size, dtype=float)
+        if not _within(self.scene.world, room, pts):  # another room's furniture may matter
+            return self._coverage(view, pts, heads, cells, boxes, size, room)
         # the answer depends on these alone: kept on the world (a tune's next trial, a study's
         # next variant flies the same sweep of the same furnished room)
         digest = hashlib.blake2b(b"".join(np.ascontiguousarray(a, dtype=float).tobytes()
                                           for a in (pts, heads, boxes, size)),
                                  digest_size=16).digest()
-        if not _within(self.scene.world, room, pts):  # another room's furniture may matter
-            return self._coverage(view, pts, heads, cells, boxes, size, room)
         memo = self.scene.world.memo("coverage", MEMO_SWEEPS)
         key = (view, room.id, len(pts), len(boxes), digest)
         if key not in memo:

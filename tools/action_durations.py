@@ -40,9 +40,9 @@ def main() -> None:
             for task, res in sim.finished:
                 if task.action == "move" or not res.ok or not task.room:
                     continue
-                size = sim.world.rooms[task.room].box.size
                 kind = sim.robots[task.robot].kind
-                seen[(kind, task.action)].append((size[0] * size[1], res.end - res.start))
+                seen[(kind, task.action)].append((sim.world.rooms[task.room].area,
+                                                  res.end - res.start))
     print(f"{'kind':6} {'action':17} {'searches':>8} {'mean s':>7} {'s/m2':>6} {'sd':>6} "
           f"{'table':>6}")
     for (kind, action), rows in sorted(seen.items()):

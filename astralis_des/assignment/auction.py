@@ -26,7 +26,7 @@ def auction(problem: Problem) -> Plan:
     queues: list[list[int]] = [[] for _ in range(n_a)]
     ends = np.zeros(n_a)  # when each queue is done, from now
     here = [problem.start(i) for i in range(n_a)]
-    search = np.array([[problem.search(i, j) for j in range(n_r)] for i in range(n_a)])
+    search = problem.search_times
     left = [j for j in range(n_r) if problem.allowed[:, j].any()]
     bids_made = 0
     while left:

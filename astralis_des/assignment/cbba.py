@@ -58,11 +58,9 @@ class CBBA:
         np.fill_diagonal(self.links, False)
         self.agents = [Agent(i, y=np.zeros(self.n_r), z=np.full(self.n_r, NONE),
                              s=np.zeros(self.n_a)) for i in range(self.n_a)]
-        self.search = np.array([[problem.search(i, j) for j in range(self.n_r)]
-                                for i in range(self.n_a)])
-        self.travel = [np.array([problem.travel_from(i, p) for p in problem.room_points])
-                       for i in range(self.n_a)]  # [i][from room, to room]
-        self.first = [problem.travel_from(i, problem.start(i)) for i in range(self.n_a)]
+        self.search = problem.search_times
+        self.travel = problem.room_legs  # [i][from room, to room]
+        self.first = problem.first_legs
         self.iteration = 0
         self.messages = 0
 

@@ -36,22 +36,19 @@ from astralis_des.assignment.plans import Plan, Problem
 from astralis_des.assignment.strategies import register_planner
 
 
-def _durations(problem: Problem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(A, R)`` search seconds, the first leg from the start, and the hop into each room
-    from its nearest other pending room."""
+def _hops(problem: Problem) -> np.ndarray:
+    """``(A, R)``: the leg into each room from its nearest other pending room."""
     n_a, n_r = problem.allowed.shape
-    search = np.array([[problem.search(i, j) for j in range(n_r)] for i in range(n_a)])
-    first = np.array([problem.travel_from(i, problem.start(i)) for i in range(n_a)])
     hop = np.zeros((n_a, n_r))
     for i in range(n_a):
-        legs = np.array([problem.travel_from(i, p) for p in problem.room_points])
+        legs = problem.room_legs[i].copy()
         np.fill_diagonal(legs, np.inf)
         hop[i] = legs.min(axis=0) if n_r > 1 else 0.0
-    return search, first, hop
+    return hop
 
 
 def _makespan(problem: Problem, search: np.ndarray, first: np.ndarray,
-              hop: np.ndarray) -> tuple[Any, list[tuple[int, int]], np.ndarray]:
+              hop: np.ndarray) -> tuple[Any, list[tuple[int, int]]]:
     """Unrelated parallel machines, latest finish (R||Cmax) with a busy agent's first leg."""
     n_a, n_r = problem.allowed.shape
     edges = [(i, j) for i in range(n_a) for j in range(n_r) if problem.allowed[i, j]]
@@ -95,11 +92,11 @@ def _makespan(problem: Problem, search: np.ndarray, first: np.ndarray,
                   integrality=integrality, bounds=Bounds(np.zeros(n), upper),
                   options=_options(problem))
     chosen = [] if result.x is None else [edges[k] for k in range(e) if result.x[k] > 0.5]
-    return result, chosen, _firsts(n_a, n_r, chosen, first)
+    return result, chosen
 
 
-def _sum(problem: Problem, search: np.ndarray, hop: np.ndarray,
-         first: np.ndarray) -> tuple[Any, list[tuple[int, int]], np.ndarray]:
+def _sum(problem: Problem, search: np.ndarray,
+         hop: np.ndarray) -> tuple[Any, list[tuple[int, int]]]:
     n_a, n_r = problem.allowed.shape
     slots = [(i, j, r) for i in range(n_a) for j in range(n_r) for r in range(1, n_r + 1)
              if problem.allowed[i, j]]
@@ -127,18 +124,7 @@ def _sum(problem: Problem, search: np.ndarray, hop: np.ndarray,
                   integrality=np.ones(n), bounds=Bounds(np.zeros(n), np.ones(n)),
                   options=_options(problem))
     chosen = [] if result.x is None else [slots[k] for k in range(n) if result.x[k] > 0.5]
-    pairs = [(i, j) for i, j, _ in chosen]
-    return result, pairs, _firsts(n_a, n_r, pairs, first)
-
-
-def _firsts(n_a: int, n_r: int, pairs: list[tuple[int, int]], first: np.ndarray) -> np.ndarray:
-    """Each busy agent's first room: the one of its rooms nearest to where it stands."""
-    f = np.zeros((n_a, n_r))
-    for i in range(n_a):
-        mine = [j for ii, j in pairs if ii == i]
-        if mine:
-            f[i, min(mine, key=lambda j: (first[i, j], j))] = 1.0
-    return f
+    return result, [(i, j) for i, j, _ in chosen]
 
 
 @contextlib.contextmanager
@@ -179,12 +165,12 @@ def _options(problem: Problem) -> dict[str, Any]:
 @register_planner("milp", whole_mission=True)
 def milp_plan(problem: Problem) -> Plan:
     objective = str(problem.options.get("objective", "makespan"))
-    search, first, hop = _durations(problem)
+    search, first, hop = problem.search_times, problem.first_legs, _hops(problem)
     if objective == "sum":
-        result, pairs, f = _sum(problem, search, hop, first)
+        result, pairs = _sum(problem, search, hop)
     else:
-        result, pairs, f = _makespan(problem, search, first, hop)
-    queues = [_chain(problem, i, [j for ii, j in pairs if ii == i], f[i])
+        result, pairs = _makespan(problem, search, first, hop)
+    queues = [_chain(problem, i, [j for ii, j in pairs if ii == i])
               for i in range(problem.allowed.shape[0])]
     gap = getattr(result, "mip_gap", None)
     info = {"objective": objective, "status": int(result.status),
@@ -194,14 +180,16 @@ def milp_plan(problem: Problem) -> Plan:
     return Plan(queues, info)
 
 
-def _chain(problem: Problem, i: int, rooms: list[int], first: np.ndarray) -> list[int]:
-    """Agent ``i``'s rooms in order: its first room, then the nearest of those left."""
+def _chain(problem: Problem, i: int, rooms: list[int]) -> list[int]:
+    """Agent ``i``'s rooms in order: the one nearest to where it stands, then the nearest of
+    those left."""
     if not rooms:
         return []
-    start = max(rooms, key=lambda j: (first[j], -j))
-    order, left = [start], [j for j in rooms if j != start]
+    first = problem.first_legs[i]
+    order = [min(rooms, key=lambda j: (first[j], j))]
+    left = [j for j in rooms if j != order[0]]
     while left:
-        legs = problem.travel_from(i, problem.room_points[order[-1]])
+        legs = problem.room_legs[i][order[-1]]
         nxt = min(left, key=lambda j: (legs[j], j))
         order.append(nxt)
         left.remove(nxt)

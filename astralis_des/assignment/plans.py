@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -43,9 +44,30 @@ class Problem:
         """Seconds agent ``i`` takes to search room ``j`` (its Table IV action)."""
         return search_seconds(self.action(i, j), self.rooms[j].area)
 
-    @property
+    @cached_property
     def room_points(self) -> NDArray[np.float64]:
         return np.array([r.position for r in self.rooms], dtype=float).reshape(-1, 3)
+
+    @cached_property
+    def search_times(self) -> NDArray[np.float64]:
+        """``(A, R)``: :meth:`search` of every agent and room."""
+        n_a, n_r = self.allowed.shape
+        return np.array([[self.search(i, j) for j in range(n_r)] for i in range(n_a)]
+                        ).reshape(n_a, n_r)
+
+    @cached_property
+    def first_legs(self) -> NDArray[np.float64]:
+        """``(A, R)``: seconds from each agent's start to each room."""
+        n_a, n_r = self.allowed.shape
+        return np.array([self.travel_from(i, self.start(i)) for i in range(n_a)]
+                        ).reshape(n_a, n_r)
+
+    @cached_property
+    def room_legs(self) -> list[NDArray[np.float64]]:
+        """Per agent, ``(R, R)``: seconds from each room to each room."""
+        return [np.array([self.travel_from(i, p) for p in self.room_points]
+                         ).reshape(len(self.rooms), len(self.rooms))
+                for i in range(len(self.agents))]
 
     def travel_from(self, i: int, point: NDArray[np.float64]) -> NDArray[np.float64]:
         """Seconds agent ``i`` takes from ``point`` to each room."""

@@ -192,7 +192,7 @@ class Simulation:
         exclude = exclude or {}
         agents = [Agent(r.id, r.kind, _xyz(r.position(self.env.now))) for r in robots]
         infos = [RoomInfo(rid, self.world.rooms[rid].center, self.rooms[rid].risk,
-                          self.rooms[rid].messiness, _floor_area(self.world.rooms[rid].box))
+                          self.rooms[rid].messiness, self.world.rooms[rid].area)
                  for rid in rooms]
         weights = Weights(cfg.weights.risk.model_dump(), cfg.weights.messiness.model_dump())
         reachable = np.array([[robot.kind not in exclude.get(rid, ()) and
@@ -328,9 +328,3 @@ def view_of(member: MemberSpec) -> View | None:
 
 def _xyz(p: np.ndarray) -> tuple[float, float, float]:
     return (float(p[0]), float(p[1]), float(p[2]))
-
-
-def _floor_area(box: Any) -> float:
-    """m^2 of a room's floor (its box's footprint)."""
-    size = box.size
-    return float(size[0] * size[1])

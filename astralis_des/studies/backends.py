@@ -178,7 +178,6 @@ class RayBackend:
             if started:
                 ray.shutdown()
 
-
     def hold(self, base: Study) -> None:
         """Nothing kept: each run starts its actors (a cluster's are shared)."""
 

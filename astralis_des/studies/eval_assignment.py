@@ -40,8 +40,7 @@ def evaluate_assignment(study: Study, scenario: Scenario, variant: Variant,
     values = scenario.values(s.risk, s.messiness)
     agents = [Agent(ident, kind, _where(study, scenario.start(kind, k)))
               for ident, kind, k in team_ids(s.team)]
-    rooms = [RoomInfo(r, world.rooms[r].center, *values[r],
-                      world.rooms[r].box.size[0] * world.rooms[r].box.size[1])
+    rooms = [RoomInfo(r, world.rooms[r].center, *values[r], world.rooms[r].area)
              for r in room_ids]
     plan = assign(agents, rooms, Weights(s.weights["risk"], s.weights["messiness"]),
                   strategy=s.strategy, solver=study.mission.spec.assignment.solver,

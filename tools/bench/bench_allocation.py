@@ -44,9 +44,8 @@ def problems(n: int, all_rooms: bool) -> list[tuple[list[Agent], list[RoomInfo]]
                else list(world.segments[segments[k % len(segments)]].rooms))
         rooms = []
         for rid in ids:
-            size = world.rooms[rid].box.size
             rooms.append(RoomInfo(rid, world.rooms[rid].center, float(rng.random()),
-                                  float(rng.random()), size[0] * size[1]))
+                                  float(rng.random()), world.rooms[rid].area))
         out.append((team, rooms))
     return out
 
