@@ -38,6 +38,9 @@ from astralis_des.world.scene import Scene
 
 log = logging.getLogger(__name__)
 Progress = Callable[[float, float], None]
+# The process that searches the mission's rooms (the timeline's rounds by default; an
+# environment's agents decide them instead): it returns why the search stopped.
+Searcher = Callable[["Simulation"], Generator[simpy.Event, Any, str]]
 
 
 class Simulation:
@@ -45,9 +48,11 @@ class Simulation:
     writes ``events.jsonl``, ``summary.json`` and ``recording.rrd`` there."""
 
     def __init__(self, mission: Mission, *, out_dir: str | Path | None = None,
-                 progress: Progress | None = None, view: bool = False) -> None:
+                 progress: Progress | None = None, view: bool = False,
+                 searcher: Searcher | None = None) -> None:
         spec = mission.spec
         self.view = view  # also stream the recording to a spawned Rerun viewer
+        self._searcher = searcher or search  # the process that decides the rounds
         self._held: list[tuple[str, str, str]] = []
         self._end: simpy.Event | None = None
         self.mission = mission
@@ -189,6 +194,22 @@ class Simulation:
         """Match ``robots`` to ``rooms``; ``exclude`` names the kinds that may not take a room
         (they searched it and saw too little)."""
         cfg = self.mission.spec.assignment
+        agents, infos, weights, reachable = self.round_inputs(rooms, robots, exclude)
+        started = time.perf_counter()
+        plan = assign(agents, infos, weights, strategy=cfg.strategy, solver=cfg.solver,
+                      high_risk=cfg.high_risk, high_messiness=cfg.high_messiness,
+                      reachable=reachable, options=cfg.options.model_dump(),
+                      rng=stream(self.mission.spec.seed, "assignment", len(self.rounds) + 1))
+        self.allocation_time.append(time.perf_counter() - started)  # wall: not in the log
+        self.record_round(segment, cfg.strategy, plan, infos)
+        return plan
+
+    def round_inputs(self, rooms: list[str], robots: list[Robot],
+                     exclude: dict[str, set[str]] | None = None
+                     ) -> tuple[list[Agent], list[RoomInfo], Weights, np.ndarray]:
+        """What a round is given: the agents where they stand, the rooms as drawn, the
+        mission's weights and who may take which room (reaches it, not ``exclude``d)."""
+        cfg = self.mission.spec.assignment
         exclude = exclude or {}
         agents = [Agent(r.id, r.kind, _xyz(r.position(self.env.now))) for r in robots]
         infos = [RoomInfo(rid, self.world.rooms[rid].center, self.rooms[rid].risk,
@@ -196,16 +217,16 @@ class Simulation:
                  for rid in rooms]
         weights = Weights(cfg.weights.risk.model_dump(), cfg.weights.messiness.model_dump())
         reachable = np.array([[robot.kind not in exclude.get(rid, ()) and
-                               self._reaches(robot, rid) for rid in rooms] for robot in robots])
-        started = time.perf_counter()
-        plan = assign(agents, infos, weights, strategy=cfg.strategy, solver=cfg.solver,
-                      high_risk=cfg.high_risk, high_messiness=cfg.high_messiness,
-                      reachable=reachable, options=cfg.options.model_dump(),
-                      rng=stream(self.mission.spec.seed, "assignment", len(self.rounds) + 1))
-        self.allocation_time.append(time.perf_counter() - started)  # wall: not in the log
+                               self._reaches(robot, rid) for rid in rooms] for robot in robots],
+                             dtype=bool).reshape(len(robots), len(rooms))
+        return agents, infos, weights, reachable
+
+    def record_round(self, segment: str, strategy: str, plan: Assignment,
+                     infos: list[RoomInfo]) -> None:
+        """A round in ``rounds`` and an ``assignment`` event: who was matched to what."""
         record: dict[str, Any] = {
             "round": len(self.rounds) + 1, "t": self.env.now, "segment": segment,
-            "strategy": cfg.strategy, "agents": list(plan.agents), "rooms": list(plan.rooms),
+            "strategy": strategy, "agents": list(plan.agents), "rooms": list(plan.rooms),
             "risk": [i.risk for i in infos], "messiness": [i.messiness for i in infos],
             "costs": [[c if np.isfinite(c) else None for c in row] for row in plan.costs.tolist()],
             "matching": [{"agent": p.agent, "room": p.room, "cost": p.cost, "action": p.action}
@@ -216,7 +237,6 @@ class Simulation:
             record["info"] = plan.info
         self.rounds.append(record)
         self.log.emit("assignment", **{k: v for k, v in record.items() if k != "t"})
-        return plan
 
     def _reaches(self, robot: Robot, room_id: str) -> bool:
         """Can this robot's kind get to the room from where it is (stairs, ramps, doors)?"""
@@ -264,7 +284,7 @@ class Simulation:
                       team=[m.id for m in spec.team])
         ends = [self.found]
         if spec.assignment.auto:  # else the rounds come from commands (the API's assign)
-            self._timeline = self.env.process(search(self))
+            self._timeline = self.env.process(self._searcher(self))
             ends.append(self._timeline)
         for event in spec.timeline:
             self.env.process(scheduled(self, event))
@@ -286,6 +306,11 @@ class Simulation:
         if not self._end.triggered and (until is None or until > self.env.now):
             self.env.run(until=until)
         return self._end.triggered
+
+    @property
+    def ended(self) -> bool:
+        """Whether the mission has ended (found, searched out, team lost or out of time)."""
+        return self._end is not None and self._end.triggered
 
     @property
     def outputs_time(self) -> float:

@@ -22,6 +22,7 @@ from astralis_des.registry import Registry
 
 if TYPE_CHECKING:
     from astralis_des.assignment import Assignment
+    from astralis_des.mission.loader import Mission
     from astralis_des.simulation.contracts import Run
 
 Handler = Callable[["Run", Any], None]
@@ -43,7 +44,7 @@ def search(sim: Run) -> Generator[simpy.Event, Any, str]:
     spec = sim.mission.spec.assignment
     if spec.start_at > 0:
         yield sim.env.timeout(spec.start_at)
-    for segment, rooms in _groups(sim):
+    for segment, rooms in groups(sim.mission):
         pending = list(rooms)
         while pending:
             agents = [r for r in sim.robots.values() if not r.faulted]
@@ -53,17 +54,17 @@ def search(sim: Run) -> Generator[simpy.Event, Any, str]:
             plan = sim.assignment_round(segment, pending, agents, exclude=sim.tried)
             if not plan.pairs:  # no agent may take any pending room: settle them
                 for room in list(pending):
-                    _settle(sim, room, "no agent left that can search it")
+                    settle(sim, room, "no agent left that can search it")
                     pending.remove(room)
                 break
             searches = dispatch(sim, plan)
             searcher = {p.room: p.agent for p in plan.pairs}
             yield from _as_they_end(sim, searches, segment == ALL,
-                                    partial(_book, sim, pending, attempts, searcher))
+                                    partial(book_search, sim, pending, attempts, searcher))
     return "not_found"
 
 
-def _book(sim: Run, pending: list[str], attempts: Counter[str], searcher: dict[str, str],
+def book_search(sim: Run, pending: list[str], attempts: Counter[str], searcher: dict[str, str],
           room: str, done: simpy.Event) -> None:
     """A search that ended: its room searched, left pending for another kind (seen too
     little) or another robot (its own broke down), or tried once more, up to the limit."""
@@ -98,13 +99,14 @@ def _as_they_end(sim: Run, searches: dict[str, simpy.Event], one_by_one: bool,
             book(room, left.pop(room))
 
 
-def _groups(sim: Run) -> list[tuple[str, list[str]]]:
+def groups(mission: Mission) -> list[tuple[str, list[str]]]:
     """The rooms a round is given: a segment's at a time, as the paper's rounds do, or every
     searched room at once (``all``) for a strategy that plans whole queues."""
-    segments = sim.mission.searched_segments()
-    if STRATEGIES.get(sim.mission.spec.assignment.strategy).whole_mission:
-        return [(ALL, [r for seg in segments for r in sim.world.segments[seg].rooms])]
-    return [(seg, list(sim.world.segments[seg].rooms)) for seg in segments]
+    segments = mission.searched_segments()
+    world = mission.world
+    if STRATEGIES.get(mission.spec.assignment.strategy).whole_mission:
+        return [(ALL, [r for seg in segments for r in world.segments[seg].rooms])]
+    return [(seg, list(world.segments[seg].rooms)) for seg in segments]
 
 
 def _undercovered(sim: Run, room: str, robot: Any, outcome: ActionResult) -> bool:
@@ -120,7 +122,7 @@ def _undercovered(sim: Run, room: str, robot: Any, outcome: ActionResult) -> boo
     return bool(others)
 
 
-def _settle(sim: Run, room: str, why: str) -> None:
+def settle(sim: Run, room: str, why: str) -> None:
     """A pending room no agent may take: searched as far as seen, if it was; else given up."""
     if room in sim.tried:
         sim.searched.append(room)

@@ -1,0 +1,59 @@
+"""Policies to run through the environments: a random one, and the paper's heuristics.
+
+``HeuristicPolicy("mixed")`` is the paper's mixed heuristic as a policy: while a round's
+searches are under way an asked robot waits (the paper's rounds wait for all of them); then
+the robots asked match the open rooms by Eq. 1 (the minimum-cost full matching) and each takes
+its room with Table IV's action. Run through :class:`~astralis_des.env.MissionEnv`, it
+reproduces ``astralis run``'s event log (with ``label="mixed"``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from astralis_des.assignment import assign
+from astralis_des.env.layout import CONTINUE, WAIT
+from astralis_des.streams import stream
+
+
+def random_policy(observation: dict[str, Any], rng: np.random.Generator) -> int:
+    """A uniformly drawn action among those the mask allows."""
+    allowed = np.flatnonzero(observation["action_mask"])
+    return int(rng.choice(allowed)) if len(allowed) else CONTINUE
+
+
+class HeuristicPolicy:
+    """One of the mission strategies that match agents to rooms (``mixed``, ``naive``,
+    ``greedy``, ``hard``, ``random``) as a policy: ``policy(env, agent) -> action``."""
+
+    def __init__(self, strategy: str = "mixed") -> None:
+        self.strategy = strategy
+        self._key: tuple[Any, ...] | None = None
+        self._actions: dict[str, int] = {}
+
+    def __call__(self, env: Any, agent: str) -> int:
+        run = env.mission_run
+        if agent not in run.asked:
+            return CONTINUE
+        if run.inflight:
+            return WAIT
+        key = (id(run), run.sim.env.now, tuple(run.asked), tuple(run.offered))
+        if key != self._key:
+            self._key, self._actions = key, self._plan(run)
+        return self._actions.get(agent, WAIT)
+
+    def _plan(self, run: Any) -> dict[str, int]:
+        sim = run.sim
+        cfg = sim.mission.spec.assignment
+        robots = [sim.robots[a] for a in run.asked]
+        agents, infos, weights, reachable = sim.round_inputs(run.offered, robots, sim.tried)
+        plan = assign(agents, infos, weights, strategy=self.strategy, solver=cfg.solver,
+                      high_risk=cfg.high_risk, high_messiness=cfg.high_messiness,
+                      reachable=reachable, options=cfg.options.model_dump(),
+                      rng=stream(sim.mission.spec.seed, "assignment", len(sim.rounds) + 1))
+        return {p.agent: run.layout.index(p.room, p.action) for p in plan.pairs}
+
+
+mixed_policy = HeuristicPolicy("mixed")
