@@ -32,6 +32,7 @@ from astralis_des.simulation import Simulation
 from astralis_des.simulation.result import RunResult
 from astralis_des.simulation.timeline import ALL, book_search, dispatch, groups, settle
 
+SETTLE = 32  # zero-time passes a decision waits for the events of its instant
 HEARD = frozenset({"fault", "recover", "room_change", "command", "cancel"})
 
 
@@ -77,6 +78,10 @@ class EpisodeRun:
         for segment, rooms in groups(sim.mission):
             self.segment, self.pending = segment, list(rooms)
             while self.pending:
+                for _ in range(SETTLE):  # the instant's other events first, so that every
+                    if sim.env.peek() != sim.env.now:  # robot free at this time is asked at
+                        break  # once (bounded: the physics stepper also waits for them)
+                    yield sim.env.timeout(0)
                 agents = [r for r in sim.robots.values() if not r.faulted]
                 if not agents:
                     sim.log.emit("team_lost", segment=segment)
