@@ -68,13 +68,19 @@ def _play(env: MissionEnv, policy: Callable[[MissionEnv, str, Any], int | None]
     return returns
 
 
-@pytest.mark.parametrize("name", ["urban_search", "fig7", "autzen_recon"])
+@pytest.mark.parametrize(("name", "fidelity"), [
+    ("urban_search", "kinematic"), ("fig7", "kinematic"), ("autzen_recon", "kinematic"),
+    ("urban_search", "physics")])
 def test_the_mixed_heuristic_through_the_env_logs_what_astralis_run_logs(
-        name: str, tmp_path: Path) -> None:
+        name: str, fidelity: str, tmp_path: Path) -> None:
+    """Byte for byte. (Not ``faults``: there a timeline command keeps the UGV busy at a round,
+    and the paper's round queues a room behind the command, where the env asks only the free.)
+    """
     path = ROOT / "missions" / f"{name}.yaml"
     with contextlib.redirect_stdout(io.StringIO()):
-        assert main(["run", str(path), "--out", str(tmp_path / "run")]) == 0
-    env = MissionEnv(path, label="mixed", out_dir=tmp_path / "env")
+        assert main(["run", str(path), "--fidelity", fidelity,
+                     "--out", str(tmp_path / "run")]) == 0
+    env = MissionEnv(path, fidelity=fidelity, label="mixed", out_dir=tmp_path / "env")
     env.reset()
     _play(env, lambda e, a, _: mixed_policy(e, a))
     env.close()

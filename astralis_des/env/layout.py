@@ -11,7 +11,7 @@ order; the actions the union of the kinds' searches (a mask leaves each agent it
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cache, cached_property
 
 from astralis_des.actions import ACTIONS
 
@@ -53,6 +53,7 @@ class Layout:
         return action if room is None else f"{action} {room}"
 
 
+@cache
 def searches_of(kind: str) -> tuple[str, ...]:
     """The search actions a kind has (Table I)."""
     return tuple(a for a in SEARCHES if (kind, a) in ACTIONS)

@@ -73,7 +73,7 @@ class Observer:
     def shared(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``time``, ``agents`` and ``rooms``, as they are now."""
         run = self.run
-        key = (run.sim.env.now, len(run.sim.log.records), tuple(run.choices.items()))
+        key = (run.sim.env.now, len(run.sim.log.records), tuple(run.asked))
         if self._key == key and self._shared is not None:
             return self._shared
         self._key, self._shared = key, (np.array([run.sim.env.now], dtype=np.float32),

@@ -127,16 +127,17 @@ class EpisodeRun:
         return not robot.faulted and self._idle(robot.id) and (hold is None or hold.processed)
 
     def _anyone_may(self, agents: list[Robot], rooms: list[str]) -> bool:
-        if not rooms:
-            return False
-        return bool(self.sim.round_inputs(rooms, agents, self.sim.tried)[3].any())
+        tried = self.sim.tried
+        return any(ok and r.kind not in tried.get(room, ())
+                   for r in agents for room, ok in zip(rooms, self.sim.reaches(r, rooms),
+                                                       strict=True))
 
     def _open(self, free: list[Robot], offered: list[str]) -> None:
         self.asked, self.offered, self.choices = [r.id for r in free], offered, {}
-        reachable = self.sim.round_inputs(offered, free, self.sim.tried)[3] if offered else None
-        self.allowed = {r.id: ({room for room, ok in zip(offered, reachable[i], strict=True)
-                                if ok} if reachable is not None else set())
-                        for i, r in enumerate(free)}
+        tried = self.sim.tried
+        self.allowed = {r.id: {room for room, ok in zip(offered, self.sim.reaches(r, offered),
+                                                        strict=True)
+                               if ok and r.kind not in tried.get(room, ())} for r in free}
 
     def _commit(self) -> None:
         """The answers of this decision time: one round for the rooms taken, then holds."""

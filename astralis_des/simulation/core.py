@@ -216,8 +216,9 @@ class Simulation:
                           self.rooms[rid].messiness, self.world.rooms[rid].area)
                  for rid in rooms]
         weights = Weights(cfg.weights.risk.model_dump(), cfg.weights.messiness.model_dump())
-        reachable = np.array([[robot.kind not in exclude.get(rid, ()) and
-                               self._reaches(robot, rid) for rid in rooms] for robot in robots],
+        reachable = np.array([[robot.kind not in exclude.get(rid, ()) and ok
+                               for rid, ok in zip(rooms, self.reaches(robot, rooms),
+                                                  strict=True)] for robot in robots],
                              dtype=bool).reshape(len(robots), len(rooms))
         return agents, infos, weights, reachable
 
@@ -238,10 +239,12 @@ class Simulation:
         self.rounds.append(record)
         self.log.emit("assignment", **{k: v for k, v in record.items() if k != "t"})
 
-    def _reaches(self, robot: Robot, room_id: str) -> bool:
-        """Can this robot's kind get to the room from where it is (stairs, ramps, doors)?"""
+    def reaches(self, robot: Robot, room_ids: list[str]) -> list[bool]:
+        """Can this robot's kind get to each room from where it is (stairs, ramps, doors)?"""
+        if not room_ids:
+            return []
         here = self.world.on_floor(robot.position(self.env.now))
-        return self.world.router.reachable(here, room_id, robot.kind)
+        return self.world.router.reachable_rooms(here, room_ids, robot.kind)
 
     # -- detection -------------------------------------------------------------------------
     def report_detection(self, robot: Robot, sighting: Sighting) -> None:

@@ -249,12 +249,20 @@ class Router:
     def reachable(self, start: FloatArray | tuple[float, ...], room_id: str, kind: str) -> bool:
         """Can a ``kind`` get from ``start`` to the room? It depends only on the place ``start``
         is in (any point of a room, corridor or the outdoors connects alike): cached."""
+        return self.reachable_rooms(start, [room_id], kind)[0]
+
+    def reachable_rooms(self, start: FloatArray | tuple[float, ...], room_ids: list[str],
+                        kind: str) -> list[bool]:
+        """:meth:`reachable` for several rooms (the place of ``start`` found once)."""
         place = self.place_of(start)
-        key = (kind, place, room_id)
-        if key not in self._reach:
-            door = self.world.rooms[room_id].door_point("corridor")
-            self._reach[key] = self.route(start, door, kind) is not None
-        return self._reach[key]
+        out = []
+        for room_id in room_ids:
+            key = (kind, place, room_id)
+            if key not in self._reach:
+                door = self.world.rooms[room_id].door_point("corridor")
+                self._reach[key] = self.route(start, door, kind) is not None
+            out.append(self._reach[key])
+        return out
 
     def route(self, start: FloatArray | tuple[float, ...], goal: FloatArray | tuple[float, ...],
               kind: str) -> FloatArray | None:

@@ -1,0 +1,115 @@
+"""Environment benchmark: decisions per second through ``astralis_des.env``, and the env's
+overhead over the kernel running the same decisions itself.
+
+    python tools/bench/bench_env.py [--episodes 40] [--physics 2]
+
+- *random*: ``MissionEnv.step`` with a random valid action (from the mask), observation
+  building included, kinematic fidelity, default team; episodes over different seeds, and the
+  same seed again and again (what a learner on one scenario sees: the world's caches warm).
+  The time inside the kernel (SimPy, the actions, sensing: what the decisions set going) is
+  printed apart from the environment's own (observations, masks, rounds, rewards, resets).
+- *overhead*: the mixed heuristic as a policy through the env against ``Simulation.run`` with
+  the mixed strategy, the same missions (the env reproduces the run's event log byte for
+  byte): wall time of one over the other. Goal (issue 22): at most 1.3x.
+- *physics*: decisions per second and simulated seconds per wall second, random policy.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+
+from astralis_des.env import MissionEnv, mixed_policy, random_policy  # noqa: E402
+from astralis_des.env.run import EpisodeRun  # noqa: E402
+from astralis_des.mission.loader import load_mission  # noqa: E402
+from astralis_des.simulation import Simulation  # noqa: E402
+
+DEFAULT = ROOT / "missions" / "urban_search.yaml"
+
+
+IN_KERNEL = [0.0]  # wall s inside the kernel (SimPy, actions, sensing) while stepping
+_run = EpisodeRun._run
+
+
+def _timed_run(self: EpisodeRun) -> None:
+    t0 = time.perf_counter()
+    _run(self)
+    IN_KERNEL[0] += time.perf_counter() - t0
+
+
+EpisodeRun._run = _timed_run  # type: ignore[method-assign]
+
+
+def episodes(env: MissionEnv, seeds: list[int], policy: str) -> tuple[int, float, float]:
+    """``(decisions, wall s, simulated s)`` over one episode per seed."""
+    rng = np.random.default_rng(0)
+    decisions, wall, simulated = 0, 0.0, 0.0
+    IN_KERNEL[0] = 0.0
+    for seed in seeds:
+        env.reset(seed=seed)
+        t0 = time.perf_counter()
+        for agent in env.agent_iter():
+            obs, _, term, trunc, _ = env.last()
+            if term or trunc:
+                env.step(None)
+                continue
+            env.step(random_policy(obs, rng) if policy == "random" else mixed_policy(env, agent))
+            decisions += 1
+        wall += time.perf_counter() - t0
+        simulated += env.mission_run.sim.env.now
+    return decisions, wall, simulated
+
+
+def kernel(seeds: list[int]) -> float:
+    """Wall s of ``Simulation.run`` (mixed strategy, no outputs) over the seeds."""
+    base = load_mission(DEFAULT)
+    wall = 0.0
+    for seed in seeds:
+        mission = base.with_changes(seed=seed)
+        t0 = time.perf_counter()
+        Simulation(mission).run()
+        wall += time.perf_counter() - t0
+    return wall
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--episodes", type=int, default=40)
+    parser.add_argument("--physics", type=int, default=2, help="physics episodes (0: none)")
+    args = parser.parse_args()
+    seeds = list(range(1, args.episodes + 1))
+    env = MissionEnv(DEFAULT)
+    episodes(env, [1000], "random")  # imports, the world's first caches
+    print(f"{'kinematic, default team':34} {'decisions':>9} {'wall s':>7} {'decisions/s':>11}"
+          f"   {'kernel s':>8} {'env s':>6} {'env-side decisions/s':>20}")
+    for label, these in (("random, a new seed each episode", seeds),
+                         ("random, one seed again and again", [7] * args.episodes)):
+        n, wall, _ = episodes(env, these, "random")
+        side = wall - IN_KERNEL[0]
+        print(f"{label:34} {n:9,} {wall:7.2f} {n / wall:11,.0f}   {IN_KERNEL[0]:8.2f} "
+              f"{side:6.2f} {n / side:20,.0f}")
+    mixed = MissionEnv(DEFAULT, label="mixed")
+    kernel(seeds)  # both warm: the world's caches hold these missions' rooms
+    episodes(mixed, seeds, "mixed")
+    t_kernel = kernel(seeds)
+    n, t_env, _ = episodes(mixed, seeds, "mixed")
+    print(f"\nmixed heuristic, {len(seeds)} missions: kernel alone {t_kernel:.2f} s, through the "
+          f"env {t_env:.2f} s ({n:,} decisions): overhead {t_env / t_kernel:.2f}x")
+    if args.physics:
+        env = MissionEnv(DEFAULT, fidelity="physics", time_limit=120.0)
+        n, wall, simulated = episodes(env, list(range(1, args.physics + 1)), "random")
+        env.close()
+        print(f"\nphysics, random policy, {args.physics} episodes of at most 120 s: {n} decisions "
+              f"in {wall:.1f} s: {n / wall:.1f} decisions/s, {simulated / wall:.1f} simulated "
+              f"s per wall s")
+
+
+if __name__ == "__main__":
+    main()
