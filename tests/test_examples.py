@@ -7,6 +7,8 @@ import json
 from pathlib import Path
 from types import ModuleType
 
+import pytest
+
 from astralis_des import Mission
 from astralis_des.api import Client
 from astralis_des.api.local import Background
@@ -50,3 +52,13 @@ def test_an_external_coordinator_finds_the_target_reproducibly(urban_search: Mis
         (tmp_path / "two" / "events.jsonl").read_bytes()
     assert (tmp_path / "one" / "summary.json").read_bytes() == \
         (tmp_path / "two" / "summary.json").read_bytes()
+
+
+def test_the_env_example_the_heuristic_beats_random() -> None:
+    pytest.importorskip("pettingzoo")
+    example = _example("env_policies")
+    runs = example.compare(ROOT / "missions" / "urban_search.yaml", 6)
+    mean = {name: sum(r for r, _, _ in rows) / len(rows) for name, rows in runs.items()}
+    assert set(mean) == {"random", "mixed heuristic"}
+    assert all(len(rows) == 6 for rows in runs.values())
+    assert mean["mixed heuristic"] > mean["random"]
