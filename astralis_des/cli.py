@@ -103,6 +103,8 @@ def _add_mission_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fidelity", choices=["kinematic", "physics"],
                         help="override the mission's fidelity")
     parser.add_argument("--no-recording", action="store_true", help="skip the Rerun recording")
+    parser.add_argument("--mcap", action="store_true", help="also write run.mcap (ROS 2 "
+                        "messages and the decisions as JSON, for ros2 bag, Foxglove, Rerun)")
 
 
 def _positive(text: str) -> int:
@@ -282,6 +284,10 @@ def _run(args: argparse.Namespace) -> int:
     from astralis_des.simulation import Simulation
 
     mission, out = mission_from_args(args)
+    if mission.spec.outputs.mcap:
+        from astralis_des.sinks.mcap_out import require
+
+        require()
     console = Console(stderr=True, quiet=args.quiet)
     try:
         result = _with_progress(console, mission.spec.time_limit,

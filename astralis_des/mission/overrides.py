@@ -21,6 +21,9 @@ def mission_from_args(args: argparse.Namespace) -> tuple[Mission, Path]:
     if args.no_recording:
         outputs = mission.spec.outputs.model_copy(update={"recording": False})
         mission = mission.with_changes(outputs=outputs.model_dump())
+    if getattr(args, "mcap", False):
+        outputs = mission.spec.outputs.model_copy(update={"mcap": True})
+        mission = mission.with_changes(outputs=outputs.model_dump())
     if getattr(args, "manual", False):  # serve and chat
         assignment = mission.spec.assignment.model_copy(update={"auto": False})
         mission = mission.with_changes(assignment=assignment.model_dump())

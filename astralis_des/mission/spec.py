@@ -334,6 +334,8 @@ class OutputsSpec(Strict):
     events: bool = True
     summary: bool = True
     recording: bool = True
+    mcap: bool = Field(False, description="also run.mcap: ROS 2 messages and the decisions as "
+                       "JSON, for ros2 bag, Foxglove and Rerun")
 
 
 class MissionSpec(Strict):

@@ -16,7 +16,7 @@ if TYPE_CHECKING:
     from astralis_des.simulation.result import RunResult
 
 
-OUTPUT_FILES = ("events.jsonl", "summary.json", "recording.rrd")
+OUTPUT_FILES = ("events.jsonl", "summary.json", "recording.rrd", "run.mcap")
 
 
 class Output(Protocol):
@@ -99,6 +99,10 @@ def open_sinks(sim: Simulation, out_dir: Path | None) -> Outputs:
             from astralis_des.sinks.recording import RerunRecorder
 
             outputs.append(RerunRecorder(sim, out_dir / "recording.rrd", view=sim.view))
+        if cfg.mcap:
+            from astralis_des.sinks.mcap_out import McapWriter
+
+            outputs.append(McapWriter(sim, out_dir / "run.mcap"))
     sinks = Outputs(outputs, time.perf_counter() - t0)
     sim.log.sinks.append(sinks.on_event)
     return sinks

@@ -1,0 +1,138 @@
+"""``astralis run --mcap``: run.mcap read back with mcap's reader and rosbags' deserialiser."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+from collections import Counter, defaultdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mcap")
+pytest.importorskip("rosbags")
+
+from mcap.reader import make_reader
+from rosbags.typesys import Stores, get_typestore
+
+from astralis_des.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+DEFAULT = ROOT / "missions" / "urban_search.yaml"
+STORE = get_typestore(Stores.ROS2_HUMBLE)
+
+
+def _run(out: Path, *extra: str) -> None:
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main(["run", str(DEFAULT), "--out", str(out), "--mcap", *extra]) == 0
+
+
+def _read(path: Path) -> tuple[dict[str, str], dict[str, list[tuple[float, Any]]]]:
+    """Each topic's schema name, and its messages (decoded) in log-time order."""
+    types: dict[str, str] = {}
+    messages: dict[str, list[tuple[float, Any]]] = defaultdict(list)
+    with path.open("rb") as f:
+        for schema, channel, message in make_reader(f).iter_messages(log_time_order=True):
+            types[channel.topic] = schema.name
+            if channel.message_encoding == "json":
+                value: Any = json.loads(message.data)
+            else:
+                value = STORE.deserialize_cdr(message.data, schema.name)
+            messages[channel.topic].append((message.log_time / 1e9, value))
+    return types, messages
+
+
+@pytest.fixture(scope="module")
+def kinematic(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict, dict]:
+    out = tmp_path_factory.mktemp("mcap") / "run"
+    _run(out)
+    return (out, *_read(out / "run.mcap"))
+
+
+@pytest.fixture(scope="module")
+def physics(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict, dict]:
+    out = tmp_path_factory.mktemp("mcap") / "physics"
+    _run(out, "--fidelity", "physics")
+    return (out, *_read(out / "run.mcap"))
+
+
+def _events(out: Path) -> list[dict[str, Any]]:
+    return [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]
+
+
+def test_topics_and_their_message_types(kinematic: tuple[Path, dict, dict]) -> None:
+    _, types, _ = kinematic
+    for robot in ("uav1", "uav2", "ugv1", "op1"):
+        assert types[f"/{robot}/pose"] == "geometry_msgs/msg/PoseStamped"
+        assert types[f"/{robot}/odom"] == "nav_msgs/msg/Odometry"
+    assert types["/uav1/plan"] == "nav_msgs/msg/Path"
+    assert types["/tf"] == "tf2_msgs/msg/TFMessage"
+    assert types["/world/markers"] == "visualization_msgs/msg/MarkerArray"
+    for topic in ("/mission/events", "/mission/tasks", "/mission/assignment",
+                  "/mission/detections"):
+        assert types[topic] == "astralis_des/Event"
+
+
+def test_the_decisions_are_the_event_log(kinematic: tuple[Path, dict, dict]) -> None:
+    out, _, messages = kinematic
+    events = _events(out)
+    assert [m for _, m in messages["/mission/events"]] == events
+    kinds = Counter(e["kind"] for e in events)
+    assert len(messages["/mission/assignment"]) == kinds["assignment"]
+    assert len(messages["/mission/tasks"]) == (kinds["task_queued"] + kinds["task_started"]
+                                               + kinds["task_finished"])
+    assert all(t == m["t"] for t, m in messages["/mission/events"])  # stamped in sim time
+
+
+def test_poses_follow_the_robots_and_end_where_the_finder_saw_the_target(
+        kinematic: tuple[Path, dict, dict]) -> None:
+    out, _, messages = kinematic
+    detection = next(e for e in _events(out) if e["kind"] == "detection")
+    poses = messages[f"/{detection['robot']}/pose"]
+    t, last = poses[-1]
+    assert t == pytest.approx(detection["t"], abs=1e-6)
+    where = last.pose.position
+    assert [where.x, where.y, where.z] == pytest.approx(detection["robot_position"], abs=1e-3)
+    stamp = last.header.stamp
+    assert stamp.sec + stamp.nanosec / 1e9 == pytest.approx(t, abs=1e-6)
+    assert last.header.frame_id == "map"
+    tfs = [m.transforms[0] for _, m in messages["/tf"]
+           if m.transforms[0].child_frame_id == f"{detection['robot']}/base_link"]
+    assert len(tfs) == len(poses)
+
+
+def test_the_world_markers_hold_walls_rooms_and_furniture(
+        kinematic: tuple[Path, dict, dict]) -> None:
+    _, _, messages = kinematic
+    (t, array), = messages["/world/markers"]
+    namespaces = Counter(m.ns for m in array.markers)
+    assert t == 0.0 and namespaces["rooms"] > 0 and namespaces["solids"] > 0
+    assert namespaces["furniture"] > 0
+    assert all(m.type == 1 and min(m.scale.x, m.scale.y, m.scale.z) > 0 for m in array.markers)
+
+
+def test_physics_sensors_come_as_ros_messages(physics: tuple[Path, dict, dict]) -> None:
+    _, types, messages = physics
+    assert types["/uav1/imu"] == "sensor_msgs/msg/Imu"
+    assert types["/uav1/camera/image"] == "sensor_msgs/msg/Image"
+    assert types["/uav1/camera/camera_info"] == "sensor_msgs/msg/CameraInfo"
+    assert types["/ugv1/scan"] == "sensor_msgs/msg/LaserScan"
+    _, image = messages["/uav1/camera/image"][0]
+    assert image.encoding == "rgb8" and len(image.data) == image.height * image.step
+    _, info = messages["/uav1/camera/camera_info"][0]
+    assert info.width == image.width and info.k[2] == pytest.approx(image.width / 2)
+    _, scan = messages["/ugv1/scan"][0]
+    ranges = np.asarray(scan.ranges)
+    assert len(ranges) == 360 and np.isfinite(ranges).any()
+    assert np.nanmin(ranges[np.isfinite(ranges)]) >= 0.0
+    hovering = [m.linear_acceleration.z for _, m in messages["/uav1/imu"][:20]]
+    assert np.median(hovering) == pytest.approx(9.81, abs=1.0)  # gravity, held off
+
+
+def test_without_the_flag_there_is_no_mcap(tmp_path: Path) -> None:
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main(["run", str(DEFAULT), "--out", str(tmp_path), "--no-recording"]) == 0
+    assert not (tmp_path / "run.mcap").exists()
