@@ -1,4 +1,4 @@
-"""Real data: the Autzen aerial LiDAR (../shared/data/real/autzen_trim.laz), and the Stanford
+"""Real data: the Autzen aerial LiDAR (data/real/autzen_trim.laz), and the Stanford
 bunny and the samurai monastery meshes of pybullet_data."""
 
 from __future__ import annotations
@@ -16,14 +16,13 @@ from astralis_des.world.build import load_world
 from astralis_des.world.clutter import place_room
 
 ROOT = Path(__file__).resolve().parents[1]
-AUTZEN = Path(__file__).resolve().parents[2] / "shared/data/real/autzen_trim.laz"
+AUTZEN = ROOT / "data" / "real" / "autzen_trim.laz"
 MESHES = Path(pybullet_data.getDataPath())
 
 
 @pytest.fixture(scope="module")
 def autzen() -> Path:
-    if not AUTZEN.is_file():
-        pytest.skip(f"real data not found: {AUTZEN} (CI has ../shared beside the checkout)")
+    assert AUTZEN.is_file(), f"{AUTZEN} is part of the repository (data/real/README.md)"
     return AUTZEN
 
 

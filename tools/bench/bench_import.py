@@ -22,7 +22,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-AUTZEN = ROOT.parent / "shared" / "data" / "real" / "autzen_trim.laz"
+AUTZEN = ROOT / "data" / "real" / "autzen_trim.laz"
 GOALS = {"autzen_trim.laz": (3.0, None), "synthetic": (30.0, 2.0)}  # s, GB
 
 # Runs in the child: import, then report time and peak memory as one JSON line.
