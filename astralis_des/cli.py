@@ -43,6 +43,12 @@ def _parser() -> argparse.ArgumentParser:
     replay = sub.add_parser("replay", help="open a run's recording in the Rerun viewer")
     replay.add_argument("recording", help="a recording.rrd")
     replay.add_argument("--web", action="store_true", help="serve the web viewer instead")
+    export = sub.add_parser("export", help="write run.mcap for a run already made")
+    export.add_argument("run_dir", help="a run's output folder (with its events.jsonl)")
+    export.add_argument("--mcap", action="store_true", required=True,
+                        help="ROS 2 messages and the decisions as JSON (the only format)")
+    export.add_argument("--mission", help="the run's mission file (default: "
+                        "missions/<name>.yaml)")
     val = sub.add_parser("validate", help="check a mission file without running it")
     val.add_argument("mission", help="mission YAML file")
     world = sub.add_parser("world", help="look at worlds")
@@ -139,6 +145,14 @@ def _replay(args: argparse.Namespace) -> int:
     from astralis_des.sinks.viewer import open_viewer
 
     return open_viewer(Path(args.recording), web=args.web)
+
+
+@command("export")
+def _export(args: argparse.Namespace) -> int:
+    from astralis_des.sinks.export import export_mcap
+
+    print(f"wrote {export_mcap(args.run_dir, args.mission)}")
+    return 0
 
 
 @command("validate")

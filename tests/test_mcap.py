@@ -136,3 +136,29 @@ def test_without_the_flag_there_is_no_mcap(tmp_path: Path) -> None:
     with contextlib.redirect_stdout(io.StringIO()):
         assert main(["run", str(DEFAULT), "--out", str(tmp_path), "--no-recording"]) == 0
     assert not (tmp_path / "run.mcap").exists()
+
+
+def test_export_writes_the_same_mcap_for_a_run_already_made(
+        kinematic: tuple[Path, dict, dict], tmp_path: Path) -> None:
+    made, _, _ = kinematic
+    out = tmp_path / "plain"
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main(["run", str(DEFAULT), "--out", str(out), "--no-recording"]) == 0
+        assert main(["export", str(out), "--mcap", "--mission", str(DEFAULT)]) == 0
+    assert (out / "run.mcap").read_bytes() == (made / "run.mcap").read_bytes()
+
+
+def test_export_refuses_a_run_its_mission_does_not_reproduce(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "run"
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main(["run", str(DEFAULT), "--out", str(out), "--no-recording"]) == 0
+    lines = (out / "events.jsonl").read_text().splitlines(keepends=True)
+    lines[5] = lines[5].replace('"task":', '"task": ', 1)
+    (out / "events.jsonl").write_text("".join(lines))
+    capsys.readouterr()  # the run's progress bar
+    assert main(["export", str(out), "--mcap", "--mission", str(DEFAULT)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: ") and "\n" not in err
+    assert "events.jsonl:6:" in err and "does not reproduce this run" in err
+    assert not (out / "run.mcap").exists()
