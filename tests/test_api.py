@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -346,3 +347,19 @@ def test_events_since_a_time_in_and_out_of_time_order(manual: Mission) -> None:
     assert not log.in_order and since(2.0) == [2.0, 2.0, 3.0, 2.5]
     last = service.handle({"op": "events", "since": 2.2, "last": 2})["result"]["events"]
     assert [e["n"] for e in last] == [3.0, 2.5]
+
+
+@pytest.mark.parametrize(("params", "message"), [
+    ({"duration": -5}, "hover: duration must be at least 0 (got -5)"),
+    ({"duration": "abc"}, "hover: duration must be a number (got 'abc')"),
+    ({"seconds": 3}, "hover has no parameter 'seconds' (its parameters: duration)"),
+])
+def test_bad_parameters_are_an_error_reply_and_the_robot_is_untouched(
+        client: Client, params: dict, message: str) -> None:
+    with pytest.raises(ApiError, match=re.escape(message)) as caught:
+        client.enqueue("uav1", "hover", params=params)
+    assert caught.value.code == "bad_args"
+    assert client.robot("uav1")["queued"] == 0 and client.robot("uav1")["task"] is None
+    client.enqueue("uav1", "hover", params={"duration": 2})
+    client.step(by=3.0)
+    assert client.robot("uav1")["task"] is None

@@ -398,3 +398,19 @@ def test_no_server_is_one_line_and_exit_2(tmp_path: Path) -> None:
     assert proc.returncode == 2
     assert proc.stderr == (f"error: no server at {address} (start one with astralis serve "
                            "MISSION.yaml)\n")
+
+
+def test_bad_parameters_are_refused_when_given_and_the_robot_stays_usable(
+        chat: Chat, client: Client) -> None:
+    """Issue 24: ``hover -5`` and ``duration=abc`` were accepted, then failed at the next
+    step with a traceback, the clock stopped and the robot stayed busy for good."""
+    assert chat.text("uav1 hover -5") == "error: hover: duration must be at least 0 (got -5)"
+    assert chat.text("uav2 hover duration=abc") == (
+        "error: hover: duration must be a number (got 'abc')")
+    assert chat.text("uav2 search A.1.1.1 spacing=2 mode=fast") == (
+        "error: spiral_inward has no parameter 'mode' (its parameters: spacing)")
+    assert client.status()["robots"]["uav1"]["queued"] == 0  # nothing was queued
+    assert chat.text("uav1 hover 3") == "queued task 1 for uav1: hover duration=3 (position 1)"
+    assert chat.text("step 5") == "t = 5.0 s"  # the clock goes on
+    assert client.robot("uav1")["task"] is None  # the hover ran and ended
+    assert chat.text("queue uav1") == "uav1: nothing running, nothing queued"

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from pydantic import Field
 
+from astralis_des.action_params import check_params
 from astralis_des.actions import ACTIONS, ROOMLESS, actions_for
 from astralis_des.api.ops import Args, NoArgs, op
 from astralis_des.api.protocol import MAX_PACE, MAX_TELEOP_STEP, ApiError
@@ -76,6 +77,10 @@ def _task(svc: Session, args: TaskArgs) -> Robot:
     for key, value in args.params.items():
         if isinstance(value, float) and not math.isfinite(value):
             raise ApiError("bad_args", f"params.{key} must be finite")
+    try:
+        check_params(args.action, dict(args.params))
+    except ValueError as exc:
+        raise ApiError("bad_args", str(exc)) from None
     if robot.faulted:
         raise ApiError("faulted", f"{robot.id} is down after a fault; it takes no tasks "
                        "until it recovers")

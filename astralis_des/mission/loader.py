@@ -6,6 +6,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from astralis_des.action_params import check_params
 from astralis_des.errors import InputError, suggest
 from astralis_des.mission.spec import CommandEvent, MissionSpec
 from astralis_des.plugins import ACTIONS, SENSORS, STRATEGIES, actions_for
@@ -144,6 +145,12 @@ def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None
             raise doc.error(("timeline", i, "action"),
                             f"a {kind} has no action '{event.action}'; "
                             f"{suggest(event.action, actions_for(kind))}")
+        if isinstance(event, CommandEvent):
+            for name in event.params:
+                try:
+                    check_params(event.action, {name: event.params[name]})
+                except ValueError as exc:
+                    raise doc.error(("timeline", i, "params", name), str(exc)) from None
     if spec.timeline and max(e.at for e in spec.timeline) > spec.time_limit:
         late = max(range(len(spec.timeline)), key=lambda k: spec.timeline[k].at)
         raise doc.error(("timeline", late, "at"), "this event comes after time_limit")

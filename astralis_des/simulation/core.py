@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 import simpy
 
+from astralis_des.action_params import check_params
 from astralis_des.actions import ACTIONS
 from astralis_des.actions.common import MotionFailed
 from astralis_des.assignment import Agent, Assignment, RoomInfo, Weights, assign
@@ -128,8 +129,10 @@ class Simulation:
     def enqueue(self, robot_id: str, action: str, room: str | None = None,
                 params: dict[str, Any] | None = None, *, origin: str = "assignment",
                 round: int | None = None, preempt: bool = False) -> simpy.Event:
-        """Queue a task for a robot; the returned event succeeds with its ActionResult."""
-        task = Task(next(self._ids), robot_id, action, room, tuple(sorted((params or {}).items())),
+        """Queue a task for a robot; the returned event succeeds with its ActionResult. A
+        parameter the action does not take, or a bad value, is a ``ValueError`` (one line)."""
+        checked = check_params(action, params or {})
+        task = Task(next(self._ids), robot_id, action, room, tuple(sorted(checked.items())),
                     origin, round)
         self.log.emit("task_queued", robot_id, task=task.id, action=action, room=room,
                       origin=origin)
