@@ -160,8 +160,10 @@ def _validate(args: argparse.Namespace) -> int:
     from astralis_des.mission.loader import load_mission
 
     mission = load_mission(args.mission)
+    search = (f"{len(mission.searched_rooms())} rooms to search" if mission.spec.assignment.auto
+              else "no rooms searched but those commanded (assignment.auto is false)")
     print(f"ok: {args.mission}: mission '{mission.name}', {len(mission.spec.team)} agents, "
-          f"{len(mission.searched_rooms())} rooms to search in world '{mission.world.name}'")
+          f"{search} in world '{mission.world.name}'")
     return 0
 
 

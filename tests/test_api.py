@@ -363,3 +363,13 @@ def test_bad_parameters_are_an_error_reply_and_the_robot_is_untouched(
     client.enqueue("uav1", "hover", params={"duration": 2})
     client.step(by=3.0)
     assert client.robot("uav1")["task"] is None
+
+
+def test_a_request_keeps_its_own_id(client: Client) -> None:
+    """Issue 24: ``request("avatar", id=...)`` overwrote the request's id and timed out."""
+    started = time.monotonic()
+    with pytest.raises(ApiError, match="'id' is the request's own key, not an argument of "
+                                       "'avatar'") as caught:
+        client.request("avatar", id="a1")
+    assert caught.value.code == "bad_args" and time.monotonic() - started < 1.0
+    assert client.avatar()["found"] is False  # the client still works

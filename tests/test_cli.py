@@ -256,3 +256,15 @@ def test_console_script_is_installed() -> None:
     proc = subprocess.run([script, "--help"], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert "validate" in proc.stdout
+
+
+def test_validate_says_what_will_really_be_searched(tmp_path: Path) -> None:
+    """Issue 24: it said "18 rooms to search" for a mission with ``auto: false``."""
+    code, out, _ = run_cli("validate", str(MISSION))
+    assert code == 0 and "18 rooms to search in world 'urban_default'" in out
+    manual = tmp_path / "manual.yaml"
+    text = MISSION.read_text()
+    manual.write_text(text.replace("world: ../worlds/urban_default.yaml", f"world: {WORLD}")
+                      .replace("assignment:\n", "assignment:\n  auto: false\n", 1))
+    code, out, _ = run_cli("validate", str(manual))
+    assert code == 0 and "no rooms searched but those commanded (assignment.auto is false)" in out

@@ -47,6 +47,10 @@ class Client:
         """Send ``{"op": op, **args}``; the reply's result, or :class:`ApiError` (the server
         refused: its code and message) or :class:`ApiTimeout` (no reply after the retries).
         ``timeout`` and ``retries`` override the client's for this request."""
+        reserved = sorted({"op", "id"} & set(args))
+        if reserved:  # the envelope's own keys: the request would lose its id and time out
+            raise ApiError("bad_args", f"'{reserved[0]}' is the request's own key, not an "
+                           f"argument of '{op}'")
         request_id = f"{self._prefix}-{next(self._ids)}"
         frame = json.dumps({"op": op, "id": request_id, **args}).encode()
         if len(frame) > MAX_MESSAGE:  # the server would refuse it, or (over its hard limit)
