@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from astralis_des.mission.loader import Mission
 from astralis_des.streams import stream
+from astralis_des.world.catalogue import agree
 from astralis_des.world.scene import Scene, Target
 
 SOUNDS = ("minimal", "moderate", "loud")
@@ -50,5 +51,6 @@ def draw_target(mission: Mission, scene: Scene) -> Target:
     for key, values in AVATAR_VALUES.items():
         drawn = values[int(avatar_gen.integers(len(values)))]
         avatar[key] = given.get(key, drawn)
+    agree(avatar, frozenset(given))
     position = tuple(float(v) for v in spec.position) if spec.position is not None else None
     return scene.place_target(room_id, avatar, position)  # type: ignore[arg-type]

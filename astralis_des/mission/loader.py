@@ -117,6 +117,10 @@ def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None
                             f"{list(spec.target.position)} is not inside room {spec.target.room}")
     elif spec.target.position is not None:
         raise doc.error(("target", "position"), "a target position needs target.room as well")
+    avatar = spec.target.avatar
+    if avatar.tied_to_chair and avatar.activity not in (None, "sitting"):
+        raise doc.error(("target", "avatar", "tied_to_chair"), "only a sitting avatar is tied "
+                        f"to a chair (activity: {avatar.activity})")
     kinds = {m.id: m.kind for m in spec.team}
     for i, member in enumerate(spec.team):
         for name in member.sensor_set.plugins:

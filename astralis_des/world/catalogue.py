@@ -86,6 +86,17 @@ class AvatarAttributes(Strict):
     tied_to_chair: tuple[StrictBool, ...] = Field((True, False), min_length=1)
 
 
+def agree(values: dict[str, object], given: frozenset[str] = frozenset()) -> dict[str, object]:
+    """Table II's attributes, drawn one by one, made to agree: only a sitting avatar is tied to
+    a chair. What a file gave (``given``) stands; a drawn value gives way to it."""
+    if values.get("tied_to_chair") and values.get("activity") != "sitting":
+        if "tied_to_chair" in given and "activity" not in given:
+            values["activity"] = "sitting"
+        else:
+            values["tied_to_chair"] = False
+    return values
+
+
 class AvatarsSpec(Strict):
     """Human bystanders: ``round(messiness * per_room_at_full)`` per room."""
 

@@ -16,7 +16,7 @@ from scipy import ndimage
 
 from astralis_des.errors import suggest
 from astralis_des.streams import stream
-from astralis_des.world.catalogue import Catalogue, avatar_size, default_catalogue
+from astralis_des.world.catalogue import Catalogue, agree, avatar_size, default_catalogue
 from astralis_des.world.freespace import CROSS, BoolArray, FreeSpace, room_free_space
 from astralis_des.world.geometry import Box
 from astralis_des.world.model import Room, World
@@ -363,8 +363,8 @@ def _count(expected: float) -> int:
 def _draw_attributes(catalogue: Catalogue,
                      rng: np.random.Generator) -> tuple[tuple[str, object], ...]:
     allowed = catalogue.avatars.attributes
-    drawn = []
+    drawn: dict[str, object] = {}
     for name in type(allowed).model_fields:
         values = getattr(allowed, name)
-        drawn.append((name, values[int(rng.integers(len(values)))]))
-    return tuple(drawn)
+        drawn[name] = values[int(rng.integers(len(values)))]
+    return tuple(agree(drawn).items())
