@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -54,6 +55,9 @@ def _parser() -> argparse.ArgumentParser:
     world = sub.add_parser("world", help="look at worlds")
     world_sub = world.add_subparsers(dest="world_command", metavar="WORLD_COMMAND",
                                      required=True)
+    rooms = world_sub.add_parser("rooms", help="list a world's buildings, storeys, segments, "
+                                 "rooms and doors (the ids a mission names)")
+    rooms.add_argument("world", help="world YAML file")
     show = world_sub.add_parser("show", help="write a recording of a world, furnished")
     show.add_argument("world", help="world YAML file")
     show.add_argument("--messiness", type=float, nargs="+", default=[0.5],
@@ -135,6 +139,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     try:
         return COMMANDS[args.command](args)
+    except BrokenPipeError:  # the reader went away (| head): no traceback, nothing more
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except InputError as exc:
         print(f"error: {exc.one_line()}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -211,6 +218,15 @@ def world_command(name: str) -> Callable[[Command], Command]:
         return fn
 
     return add
+
+
+@world_command("rooms")
+def _world_rooms(args: argparse.Namespace) -> int:
+    from astralis_des.world.build import load_world
+    from astralis_des.world.describe import room_lines
+
+    print("\n".join(room_lines(load_world(args.world))))
+    return 0
 
 
 @world_command("import")

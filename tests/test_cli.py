@@ -268,3 +268,15 @@ def test_validate_says_what_will_really_be_searched(tmp_path: Path) -> None:
                       .replace("assignment:\n", "assignment:\n  auto: false\n", 1))
     code, out, _ = run_cli("validate", str(manual))
     assert code == 0 and "no rooms searched but those commanded (assignment.auto is false)" in out
+
+
+def test_world_rooms_lists_what_a_mission_can_name() -> None:
+    code, out, _ = run_cli("world", "rooms", str(WORLD))
+    assert code == 0
+    assert out.splitlines()[0].startswith("world urban_default: site 220 x 175 m; 8 segments, "
+                                          "24 rooms; A: 3 storeys of 3.5 m, 18 rooms")
+    row = next(line for line in out.splitlines() if line.startswith("A.1.1.1 "))
+    assert row.split() == ["A.1.1.1", "A.1.1", "1", "64.1..67.9,", "79.6..86.4", "25.8",
+                           "66,", "79.5,", "0", "A.1.corridor"]
+    assert sum(line.startswith("A.2.1.") for line in out.splitlines()) == 3
+    assert len(out.splitlines()) == 2 + 24
