@@ -222,8 +222,9 @@ def test_status_shows_the_team_and_the_time(chat: Chat) -> None:
 def test_a_search_is_queued_then_listed_then_cancelled(chat: Chat, client: Client) -> None:
     """uav1 search, queue uav1, cancel uav1: the replies and the server agree."""
     assert chat.text("uav1 search A.2.1.3 inward") == \
-        "queued task 1 for uav1: spiral_inward A.2.1.3 (position 1)"
-    assert chat.text("uav1 hover 20") == "queued task 2 for uav1: hover duration=20 (position 2)"
+        "queued task 1 for uav1: spiral_inward A.2.1.3 (next to run)"
+    assert chat.text("uav1 hover 20") == \
+        "queued task 2 for uav1: hover duration=20 (1 queued ahead of it)"
     assert chat.text("queue uav1") == ("uav1: nothing running; queued, in order:\n"
                                        "  task 1: spiral_inward A.2.1.3\n"
                                        "  task 2: hover duration=20")
@@ -410,7 +411,20 @@ def test_bad_parameters_are_refused_when_given_and_the_robot_stays_usable(
     assert chat.text("uav2 search A.1.1.1 spacing=2 mode=fast") == (
         "error: spiral_inward has no parameter 'mode' (its parameters: spacing)")
     assert client.status()["robots"]["uav1"]["queued"] == 0  # nothing was queued
-    assert chat.text("uav1 hover 3") == "queued task 1 for uav1: hover duration=3 (position 1)"
+    assert chat.text("uav1 hover 3") == "queued task 1 for uav1: hover duration=3 (next to run)"
     assert chat.text("step 5") == "t = 5.0 s"  # the clock goes on
     assert client.robot("uav1")["task"] is None  # the hover ran and ended
     assert chat.text("queue uav1") == "uav1: nothing running, nothing queued"
+
+
+def test_the_queue_is_right_just_after_a_preempt(chat: Chat, client: Client) -> None:
+    """Issue 24: after ``uav2 hover 5 now`` the interrupted task showed as running until the
+    next step."""
+    chat.text("uav2 hover 30")
+    chat.text("step 1")
+    assert chat.text("uav2 hover 5 now") == ("task 2 for uav2 runs now: hover duration=5; "
+                                             "task 1 interrupted")
+    assert chat.text("queue uav2") == "uav2: running task 2: hover duration=5, nothing queued"
+    assert client.robot("uav2")["task"] == 2
+    chat.text("step 2")
+    assert chat.text("queue uav2") == "uav2: running task 2: hover duration=5, nothing queued"

@@ -120,9 +120,9 @@ def _queue(svc: Session, args: RobotArgs) -> dict[str, Any]:
     """A robot's running task and the tasks waiting, in the order they will run."""
     robot = svc.robot(args.robot)
     handler = svc.sim.handler(robot.id)
-    current = handler.current
+    current, queued = handler.view()
     return {"robot": robot.id, "current": task_dict(current) if current is not None else None,
-            "queued": [task_dict(t) for t in handler.queued]}
+            "queued": [task_dict(t) for t in queued]}
 
 
 @op("events", EventsArgs)
@@ -169,7 +169,7 @@ def _time(rec: dict[str, Any]) -> float:
 def robot_state(svc: Session, robot: Robot) -> dict[str, Any]:
     now = svc.now
     handler = svc.sim.handler(robot.id)
-    current = handler.current
+    current, queued = handler.view()
     position = robot.position(now)
     travelled = robot.motion.travelled(now) if robot.motion is not None else 0.0
     state = "faulted" if robot.faulted else ("busy" if current is not None else "idle")
@@ -177,7 +177,7 @@ def robot_state(svc: Session, robot: Robot) -> dict[str, Any]:
             "heading": heading_of(robot, now), "state": state,
             "command": current.describe() if current is not None else None,
             "task": current.id if current is not None else None,
-            "queued": len(handler.queued), "distance": robot.distance + travelled}
+            "queued": len(queued), "distance": robot.distance + travelled}
 
 
 def heading_of(robot: Robot, now: float) -> float:

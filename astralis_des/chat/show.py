@@ -170,8 +170,9 @@ def _short(value: Any) -> str:
 @shows("enqueue")
 def _enqueue(parsed: Parsed, r: dict[str, Any]) -> RenderableType:
     what = task_text(parsed.args)
-    return Text(f"queued task {r['task']} for {r['robot']}: {what} (position "
-                f"{r['position'] + 1})")
+    ahead = int(r["position"])  # the API's position: how many queued tasks run before it
+    where = "next to run" if ahead == 0 else f"{ahead} queued ahead of it"
+    return Text(f"queued task {r['task']} for {r['robot']}: {what} ({where})")
 
 
 @shows("preempt")

@@ -30,6 +30,7 @@ class TaskHandler:
         self._on_change = on_change
         self._get: simpy.Event | None = None
         self._dropped: set[int] = set()
+        self._stopping: Task | None = None
         self.worker = env.process(self._work())
 
     def _taken(self) -> Task | None:
@@ -89,6 +90,16 @@ class TaskHandler:
         active = self._active
         if active is not None and active.is_alive and active is not self.env.active_process:
             active.interrupt(cause)
+            self._stopping = self.current  # it ends when the interrupt lands (same instant)
+
+    def view(self) -> tuple[Task | None, list[Task]]:
+        """``(running, queued)`` as a user should see them: a task already told to stop (it
+        ends at this instant, when the interrupt lands) is gone, and the task preempting it
+        runs."""
+        current, queued = self.current, self.queued
+        if current is not None and current is self._stopping:
+            return (queued[0], queued[1:]) if queued else (None, queued)
+        return current, queued
 
     def _drop(self, task: Task, status: TaskStatus, reason: str) -> None:
         """End a task that has not started: take it out of the queue, or skip it if taken."""
@@ -114,7 +125,7 @@ class TaskHandler:
                 self._on_change(task, None)
             result = yield self._active
             self._active = None
-            self.current = None
+            self.current = self._stopping = None
             self._settle(task, result)
 
     def _settle(self, task: Task, result: ActionResult) -> None:
