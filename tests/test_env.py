@@ -229,3 +229,20 @@ def test_observations_say_what_the_mission_knows() -> None:
     assert obs["rooms"][first, 6] == pytest.approx(sim.rooms["A.1.1.1"].risk)
     assert env.state().shape == env.state_space.shape
     assert env.observation_space("uav1").contains(env.observe("uav1"))
+
+
+def test_the_heuristic_policy_follows_each_episode(tmp_path: Path) -> None:
+    """Episode after episode (new seeds: other risks, other rooms), the policy plans for the
+    episode at hand: each reproduces the kernel's own run of that seed."""
+    from astralis_des.mission.loader import load_mission
+    from astralis_des.simulation import Simulation
+
+    env = MissionEnv(DEFAULT, label="mixed", out_dir=tmp_path / "env")
+    for episode, seed in enumerate((1, 2, 3), start=1):
+        env.reset(seed=seed)
+        _play(env, lambda e, a, _: mixed_policy(e, a))
+        Simulation(load_mission(DEFAULT).with_changes(seed=seed),
+                   out_dir=tmp_path / f"run{seed}").run()
+        ran = (tmp_path / f"run{seed}" / "events.jsonl").read_bytes()
+        assert (tmp_path / "env" / f"episode_{episode:04d}" / "events.jsonl").read_bytes() == ran
+    env.close()

@@ -31,6 +31,7 @@ class HeuristicPolicy:
     def __init__(self, strategy: str = "mixed") -> None:
         self.strategy = strategy
         self._key: tuple[Any, ...] | None = None
+        self._run: Any = None  # the episode the key is of (an id could be reused after it)
         self._actions: dict[str, int] = {}
 
     def __call__(self, env: Any, agent: str) -> int:
@@ -39,9 +40,10 @@ class HeuristicPolicy:
             return CONTINUE
         if run.inflight:
             return WAIT
-        key = (id(run), run.sim.env.now, tuple(run.asked), tuple(run.offered))
-        if key != self._key:
-            self._key, self._actions = key, self._plan(run)
+        key = (run.sim.env.now, len(run.sim.log.records), tuple(run.asked),
+               tuple(run.offered))
+        if run is not self._run or key != self._key:
+            self._run, self._key, self._actions = run, key, self._plan(run)
         return self._actions.get(agent, WAIT)
 
     def _plan(self, run: Any) -> dict[str, int]:
