@@ -79,7 +79,7 @@ class McapWriter:
         messages = sorted(self._messages(ty), key=lambda m: m[0])  # stable: ties keep order
         tmp = self.path.with_name(self.path.name + ".tmp")
         with tmp.open("wb") as f:
-            writer = Writer(f, compression=CompressionType.ZSTD)
+            writer = Writer(f, compression=CompressionType.LZ4)  # ZSTD: 25% smaller, slower
             writer.start(profile="ros2", library="astralis-des")
             channels: dict[str, int] = {}
             json_schema = writer.register_schema(

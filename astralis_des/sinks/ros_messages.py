@@ -63,11 +63,13 @@ def quaternion(ty: Types, yaw: float = 0.0, matrix: np.ndarray | None = None) ->
 
 
 def point(ty: Types, p: Any) -> Any:
-    return ty.geometry_msgs__Point(x=float(p[0]), y=float(p[1]), z=float(p[2]))
+    x, y, z = (float(v) for v in p)
+    return ty.geometry_msgs__Point(x=x, y=y, z=z)
 
 
 def vector(ty: Types, p: Any) -> Any:
-    return ty.geometry_msgs__Vector3(x=float(p[0]), y=float(p[1]), z=float(p[2]))
+    x, y, z = (float(v) for v in p)
+    return ty.geometry_msgs__Vector3(x=x, y=y, z=z)
 
 
 def yaws(points: np.ndarray) -> np.ndarray:
@@ -87,7 +89,8 @@ def yaws(points: np.ndarray) -> np.ndarray:
 
 def robot_poses(ty: Types, sim: Simulation) -> Iterator[Stamped]:
     """Per robot and trail point: its TF, PoseStamped and Odometry (the twist from the next
-    point)."""
+    point). The three share their header, pose and quaternion (read-only messages)."""
+    zero36, still = np.zeros(36), vector(ty, (0.0, 0.0, 0.0))
     for rid, robot in sim.robots.items():
         times = np.asarray(robot.trail_t, dtype=float)
         pts = np.asarray(robot.trail_p, dtype=float).reshape(-1, 3)
@@ -97,24 +100,21 @@ def robot_poses(ty: Types, sim: Simulation) -> Iterator[Stamped]:
             dt = np.maximum(np.diff(times), 1e-9)[:, None]
             vel[:-1] = np.diff(pts, axis=0) / dt
         frame = f"{rid}/base_link"
-        for k, t in enumerate(times):
-            pose = ty.geometry_msgs__Pose(position=point(ty, pts[k]),
-                                          orientation=quaternion(ty, yaw[k]))
+        for k, t in enumerate(times.tolist()):
+            h = header(ty, t, "map")
+            q = quaternion(ty, float(yaw[k]))
+            pose = ty.geometry_msgs__Pose(position=point(ty, pts[k]), orientation=q)
             tf = ty.geometry_msgs__TransformStamped(
-                header=header(ty, t, "map"), child_frame_id=frame,
-                transform=ty.geometry_msgs__Transform(translation=vector(ty, pts[k]),
-                                                      rotation=quaternion(ty, yaw[k])))
+                header=h, child_frame_id=frame,
+                transform=ty.geometry_msgs__Transform(translation=vector(ty, pts[k]), rotation=q))
             yield t, "/tf", "tf2_msgs/msg/TFMessage", ty.tf2_msgs__TFMessage(transforms=[tf])
             yield (t, f"/{rid}/pose", "geometry_msgs/msg/PoseStamped",
-                   ty.geometry_msgs__PoseStamped(header=header(ty, t, "map"), pose=pose))
-            twist = ty.geometry_msgs__Twist(linear=vector(ty, vel[k]),
-                                            angular=vector(ty, (0.0, 0.0, 0.0)))
+                   ty.geometry_msgs__PoseStamped(header=h, pose=pose))
+            twist = ty.geometry_msgs__Twist(linear=vector(ty, vel[k]), angular=still)
             yield (t, f"/{rid}/odom", "nav_msgs/msg/Odometry", ty.nav_msgs__Odometry(
-                header=header(ty, t, "map"), child_frame_id=frame,
-                pose=ty.geometry_msgs__PoseWithCovariance(pose=pose,
-                                                           covariance=np.zeros(36)),
-                twist=ty.geometry_msgs__TwistWithCovariance(twist=twist,
-                                                             covariance=np.zeros(36))))
+                header=h, child_frame_id=frame,
+                pose=ty.geometry_msgs__PoseWithCovariance(pose=pose, covariance=zero36),
+                twist=ty.geometry_msgs__TwistWithCovariance(twist=twist, covariance=zero36)))
 
 
 def planned_paths(ty: Types, sim: Simulation) -> Iterator[Stamped]:
