@@ -64,8 +64,8 @@ def search(sim: Run) -> Generator[simpy.Event, Any, str]:
     return "not_found"
 
 
-def book_search(sim: Run, pending: list[str], attempts: Counter[str], searcher: dict[str, str],
-          room: str, done: simpy.Event) -> None:
+def book_search(sim: Run, pending: list[str], attempts: Counter[str],
+                searcher: dict[str, str], room: str, done: simpy.Event) -> None:
     """A search that ended: its room searched, left pending for another kind (seen too
     little) or another robot (its own broke down), or tried once more, up to the limit."""
     outcome = cast(ActionResult, done.value)
