@@ -102,6 +102,8 @@ def _parser() -> argparse.ArgumentParser:
     COMMANDS.update(API_COMMANDS)  # not by import: under python -m this module is __main__
     schema = sub.add_parser("schema", help="print the JSON Schema of mission or world files")
     schema.add_argument("--world", action="store_true", help="the world file's schema")
+    schema.add_argument("--markdown", action="store_true", help="the mission file's reference "
+                        "as a Markdown table (docs/missions.md)")
     schema.add_argument("-o", "--output", help="write to this file instead of stdout")
     return parser
 
@@ -301,6 +303,10 @@ def _schema(args: argparse.Namespace) -> int:
 
     model = WorldSpec if args.world else MissionSpec
     text = json.dumps(model.model_json_schema(), indent=2) + "\n"
+    if args.markdown:
+        from astralis_des.mission.reference import EXAMPLE, reference
+
+        text = reference(Path(EXAMPLE))
     if args.output:
         Path(args.output).write_text(text, encoding="utf-8")
     else:

@@ -1,0 +1,122 @@
+"""``docs/missions.md``: every key of a mission file, made from the schema so it cannot drift.
+
+    astralis schema --markdown -o docs/missions.md
+
+A row per key (dotted path; ``[]`` an item of a list, ``{}`` a value of a map): its type, its
+default, what it means (units in the description) and, where the default mission sets it, the
+value it has there as an example.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from astralis_des.mission.spec import MissionSpec
+
+EXAMPLE = "missions/urban_search.yaml"
+INTRO = """# Mission file reference
+
+Generated from the schema (`astralis schema --markdown -o docs/missions.md`; a test checks that
+it is up to date). A mission is a YAML file; `astralis validate FILE` checks one, and
+`astralis world rooms WORLD` lists the ids of rooms, segments and doors it can name. Keys are
+dotted paths: `team[]` is an item of the list `team` (`timeline[event=fault]` one of its
+events of that kind), `rooms.set{}` a value of the map `rooms.set`. The example column is the
+value in `{example}`, where it sets the key. Timeline events are told apart by `event`
+(`fault`, `recover`, `room_change`, `command`, `cancel`); a command's `params` are the
+action's own (`astralis_des/action_params.py`).
+
+| key | type | default | what | example |
+| --- | --- | --- | --- | --- |
+"""
+
+
+def reference(example: Path | None = None) -> str:
+    schema = MissionSpec.model_json_schema()
+    defs = schema.get("$defs", {})
+    values: Any = {}
+    if example is not None and example.is_file():
+        values = yaml.safe_load(example.read_text(encoding="utf-8")) or {}
+    rows: list[str] = []
+    _walk(schema, defs, "", rows, values, set())
+    return INTRO.replace("{example}", EXAMPLE) + "\n".join(rows) + "\n"
+
+
+def _resolve(node: dict[str, Any], defs: dict[str, Any]) -> dict[str, Any]:
+    if "$ref" in node:
+        return defs[node["$ref"].split("/")[-1]]
+    return node
+
+
+def _type(node: dict[str, Any], defs: dict[str, Any]) -> str:
+    if "$ref" in node:
+        return node["$ref"].split("/")[-1].removesuffix("Spec").lower() or "object"
+    if "enum" in node:
+        return " \\| ".join(json.dumps(v) for v in node["enum"])
+    if "const" in node:
+        return json.dumps(node["const"])
+    for key in ("anyOf", "oneOf"):
+        if key in node:
+            return " \\| ".join(_type(n, defs) for n in node[key])
+    kind = node.get("type", "any")
+    if kind == "array":
+        items = node.get("items")
+        if isinstance(items, dict) and items:
+            return f"list of {_type(items, defs)}"
+        prefix = node.get("prefixItems")
+        if prefix:
+            return "[" + ", ".join(_type(n, defs) for n in prefix) + "]"
+        return "list"
+    if kind == "object" and isinstance(node.get("additionalProperties"), dict):
+        return f"map of {_type(node['additionalProperties'], defs)}"
+    limits = [f"{op} {node[k]:g}" for k, op in (("minimum", ">="), ("exclusiveMinimum", ">"),
+                                                  ("maximum", "<="), ("exclusiveMaximum", "<"))
+              if k in node and abs(node[k]) < 1e6]  # not the sanity bounds of coordinates
+    return str(kind) + (f" ({', '.join(limits)})" if limits else "")
+
+
+def _cell(value: Any) -> str:
+    text = json.dumps(value) if not isinstance(value, str) else value
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def _walk(node: dict[str, Any], defs: dict[str, Any], path: str, rows: list[str], example: Any,
+          seen: set[str]) -> None:
+    node = _resolve(node, defs)
+    for name, sub in node.get("properties", {}).items():
+        key = f"{path}.{name}" if path else name
+        here = example.get(name) if isinstance(example, dict) else None
+        default = json.dumps(sub["default"]) if "default" in sub else (
+            "required" if name in node.get("required", []) else "")
+        what = sub.get("description", "") or _resolve(sub, defs).get("description", "")
+        plain = here is not None and not isinstance(here, dict) and not (
+            isinstance(here, list) and any(isinstance(v, dict | list) for v in here))
+        shown = _cell(here) if plain else ""
+        rows.append(f"| `{key}` | {_type(sub, defs)} | {_cell(default)} | "
+                    f"{_cell(' '.join(what.split()))} | {shown} |")
+        _children(sub, defs, key, rows, here, seen)
+
+
+def _children(sub: dict[str, Any], defs: dict[str, Any], key: str, rows: list[str],
+              here: Any, seen: set[str]) -> None:
+    options = [sub] + sub.get("anyOf", []) + sub.get("oneOf", [])
+    for option in options:
+        ref = option.get("$ref")
+        if ref and ref not in seen:
+            _walk(option, defs, key, rows, here, seen | {ref})
+        elif option.get("type") == "array":
+            items = option.get("items", {})
+            item = here[0] if isinstance(here, list) and here else None
+            for choice in [items] + items.get("anyOf", []) + items.get("oneOf", []):
+                if "$ref" in choice and choice["$ref"] not in seen:
+                    tag = _resolve(choice, defs).get("properties", {}).get("event", {})
+                    where = f"{key}[event={tag['const']}]" if "const" in tag else f"{key}[]"
+                    _walk(choice, defs, where, rows, item, seen | {choice["$ref"]})
+        elif isinstance(option.get("additionalProperties"), dict):
+            value = option["additionalProperties"]
+            first = next(iter(here.values()), None) if isinstance(here, dict) and here else None
+            if "$ref" in value and value["$ref"] not in seen:
+                _walk(value, defs, f"{key}{{}}", rows, first, seen | {value["$ref"]})
