@@ -12,15 +12,14 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, ClassVar
 
-import numpy as np
 from pettingzoo import AECEnv
 
-from astralis_des.env.base import Episodes
+from astralis_des.env.base import Front
 from astralis_des.env.rewards import Progress, RewardFn
 from astralis_des.mission.loader import Mission
 
 
-class MissionEnv(AECEnv[str, dict[str, Any], int]):
+class MissionEnv(Front, AECEnv[str, dict[str, Any], int]):
     """A mission as an AEC environment. See :class:`astralis_des.env.base.Episodes` for the
     arguments."""
 
@@ -32,29 +31,11 @@ class MissionEnv(AECEnv[str, dict[str, Any], int]):
                  label: str = "env", hold_s: float = 10.0,
                  out_dir: str | Path | None = None) -> None:
         super().__init__()
-        self.episodes = Episodes(mission, fidelity=fidelity, time_limit=time_limit,
-                                 reward=reward, label=label, hold_s=hold_s, out_dir=out_dir)
-        self.possible_agents = list(self.episodes.possible_agents)
-        self.observation_spaces = self.episodes.observation_spaces
-        self.action_spaces = self.episodes.action_spaces
-        self.state_space = self.episodes.state_space
-        self.agents: list[str] = []
-        self.render_mode = None
-
-    def observation_space(self, agent: str) -> Any:
-        return self.episodes.observation_space(agent)
-
-    def action_space(self, agent: str) -> Any:
-        return self.episodes.action_space(agent)
-
-    @property
-    def mission_run(self) -> Any:
-        """The current episode's :class:`~astralis_des.env.run.EpisodeRun` (its ``sim`` is the
-        :class:`~astralis_des.simulation.Simulation`)."""
-        return self.episodes.run
+        self._open(mission, fidelity=fidelity, time_limit=time_limit, reward=reward,
+                   label=label, hold_s=hold_s, out_dir=out_dir)
 
     def reset(self, seed: int | None = None, options: dict[str, Any] | None = None) -> None:
-        self.episodes._start(seed)
+        self.episodes.start(seed)
         self.agents = list(self.possible_agents)
         self.rewards = dict.fromkeys(self.agents, 0.0)
         self._cumulative_rewards = dict.fromkeys(self.agents, 0.0)
@@ -66,10 +47,6 @@ class MissionEnv(AECEnv[str, dict[str, Any], int]):
     def observe(self, agent: str) -> dict[str, Any]:
         assert self.episodes.observer is not None
         return self.episodes.observer.observe(agent)
-
-    def state(self) -> np.ndarray:
-        assert self.episodes.observer is not None
-        return self.episodes.observer.state()
 
     def step(self, action: Any) -> None:
         agent = self.agent_selection
@@ -106,11 +83,3 @@ class MissionEnv(AECEnv[str, dict[str, Any], int]):
             self.agent_selection = waiting[0]
         elif self.agents:
             self.agent_selection = self.agents[0]
-
-    def render(self) -> None:
-        """Nothing to draw here: the episode's recording (``out_dir``) is for Rerun."""
-        return None
-
-    def close(self) -> None:
-        self.episodes.close_run()
-

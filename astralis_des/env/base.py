@@ -60,7 +60,7 @@ class Episodes:
     def action_space(self, agent: str) -> spaces.Space[Any]:
         return self.action_spaces[agent]
 
-    def _start(self, seed: int | None) -> None:
+    def start(self, seed: int | None) -> None:
         """A new episode: the mission with ``seed`` (given), else the mission's own seed the
         first time and then seeds drawn from it, one per episode."""
         self.close_run()
@@ -102,3 +102,42 @@ class Episodes:
         if self.run is not None:
             self.run.close()
 
+
+
+class Front:
+    """What both environment classes show of their :class:`Episodes` (the spaces, the
+    episode's run, the state, rendering and closing): put before the PettingZoo base."""
+
+    episodes: Episodes
+
+    def _open(self, mission: Mission | str | Path, **options: Any) -> None:
+        self.episodes = Episodes(mission, **options)
+        self.possible_agents = list(self.episodes.possible_agents)
+        self.observation_spaces = self.episodes.observation_spaces
+        self.action_spaces = self.episodes.action_spaces
+        self.state_space = self.episodes.state_space
+        self.agents: list[str] = []
+        self.render_mode = None
+
+    def observation_space(self, agent: str) -> Any:
+        return self.episodes.observation_space(agent)
+
+    def action_space(self, agent: str) -> Any:
+        return self.episodes.action_space(agent)
+
+    @property
+    def mission_run(self) -> Any:
+        """The current episode's :class:`~astralis_des.env.run.EpisodeRun` (its ``sim`` is the
+        :class:`~astralis_des.simulation.Simulation`)."""
+        return self.episodes.run
+
+    def state(self) -> np.ndarray:
+        assert self.episodes.observer is not None
+        return self.episodes.observer.state()
+
+    def render(self) -> None:
+        """Nothing to draw here: the episode's recording (``out_dir``) is for Rerun."""
+        return None
+
+    def close(self) -> None:
+        self.episodes.close_run()

@@ -12,16 +12,15 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, ClassVar
 
-import numpy as np
 from pettingzoo import ParallelEnv
 
-from astralis_des.env.base import Episodes
+from astralis_des.env.base import Front
 from astralis_des.env.layout import CONTINUE
 from astralis_des.env.rewards import RewardFn
 from astralis_des.mission.loader import Mission
 
 
-class ParallelMissionEnv(ParallelEnv[str, dict[str, Any], int]):
+class ParallelMissionEnv(Front, ParallelEnv[str, dict[str, Any], int]):
     """A mission as a parallel environment. See :class:`astralis_des.env.base.Episodes` for
     the arguments."""
 
@@ -32,28 +31,12 @@ class ParallelMissionEnv(ParallelEnv[str, dict[str, Any], int]):
                  time_limit: float | None = None, reward: RewardFn | None = None,
                  label: str = "env", hold_s: float = 10.0,
                  out_dir: str | Path | None = None) -> None:
-        self.episodes = Episodes(mission, fidelity=fidelity, time_limit=time_limit,
-                                 reward=reward, label=label, hold_s=hold_s, out_dir=out_dir)
-        self.possible_agents = list(self.episodes.possible_agents)
-        self.observation_spaces = self.episodes.observation_spaces
-        self.action_spaces = self.episodes.action_spaces
-        self.state_space = self.episodes.state_space
-        self.agents: list[str] = []
-        self.render_mode = None
-
-    def observation_space(self, agent: str) -> Any:
-        return self.episodes.observation_space(agent)
-
-    def action_space(self, agent: str) -> Any:
-        return self.episodes.action_space(agent)
-
-    @property
-    def mission_run(self) -> Any:
-        return self.episodes.run
+        self._open(mission, fidelity=fidelity, time_limit=time_limit, reward=reward,
+                   label=label, hold_s=hold_s, out_dir=out_dir)
 
     def reset(self, seed: int | None = None, options: dict[str, Any] | None = None
               ) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
-        self.episodes._start(seed)
+        self.episodes.start(seed)
         self.agents = list(self.possible_agents)
         return self._observations(), {a: {} for a in self.agents}
 
@@ -61,10 +44,6 @@ class ParallelMissionEnv(ParallelEnv[str, dict[str, Any], int]):
         observer = self.episodes.observer
         assert observer is not None
         return {a: observer.observe(a) for a in self.agents}
-
-    def state(self) -> np.ndarray:
-        assert self.episodes.observer is not None
-        return self.episodes.observer.state()
 
     def step(self, actions: dict[str, Any]) -> tuple[dict[str, Any], dict[str, float],
                                                       dict[str, bool], dict[str, bool],
@@ -92,10 +71,3 @@ class ParallelMissionEnv(ParallelEnv[str, dict[str, Any], int]):
                 infos[agent]["outcome"] = run.result.outcome
             self.agents = []
         return observations, rewards, terminations, truncations, infos
-
-    def render(self) -> None:
-        """Nothing to draw here: the episode's recording (``out_dir``) is for Rerun."""
-        return None
-
-    def close(self) -> None:
-        self.episodes.close_run()

@@ -127,17 +127,13 @@ class EpisodeRun:
         return not robot.faulted and self._idle(robot.id) and (hold is None or hold.processed)
 
     def _anyone_may(self, agents: list[Robot], rooms: list[str]) -> bool:
-        tried = self.sim.tried
-        return any(ok and r.kind not in tried.get(room, ())
-                   for r in agents for room, ok in zip(rooms, self.sim.reaches(r, rooms),
-                                                       strict=True))
+        return bool(self.sim.allowed(agents, rooms, self.sim.tried).any())
 
     def _open(self, free: list[Robot], offered: list[str]) -> None:
         self.asked, self.offered, self.choices = [r.id for r in free], offered, {}
-        tried = self.sim.tried
-        self.allowed = {r.id: {room for room, ok in zip(offered, self.sim.reaches(r, offered),
-                                                        strict=True)
-                               if ok and r.kind not in tried.get(room, ())} for r in free}
+        allowed = self.sim.allowed(free, offered, self.sim.tried)
+        self.allowed = {r.id: {room for room, ok in zip(offered, allowed[i], strict=True) if ok}
+                        for i, r in enumerate(free)}
 
     def _commit(self) -> None:
         """The answers of this decision time: one round for the rooms taken, then holds."""

@@ -219,11 +219,16 @@ class Simulation:
                           self.rooms[rid].messiness, self.world.rooms[rid].area)
                  for rid in rooms]
         weights = Weights(cfg.weights.risk.model_dump(), cfg.weights.messiness.model_dump())
-        reachable = np.array([[robot.kind not in exclude.get(rid, ()) and ok
-                               for rid, ok in zip(rooms, self.reaches(robot, rooms),
-                                                  strict=True)] for robot in robots],
-                             dtype=bool).reshape(len(robots), len(rooms))
-        return agents, infos, weights, reachable
+        return agents, infos, weights, self.allowed(robots, rooms, exclude)
+
+    def allowed(self, robots: list[Robot], rooms: list[str],
+                exclude: dict[str, set[str]] | None = None) -> np.ndarray:
+        """``(robots, rooms)``: who may take which room: it gets there from where it is, and
+        its kind is not ``exclude``d from the room (it saw too little of it)."""
+        exclude = exclude or {}
+        return np.array([[robot.kind not in exclude.get(rid, ()) and ok
+                          for rid, ok in zip(rooms, self.reaches(robot, rooms), strict=True)]
+                         for robot in robots], dtype=bool).reshape(len(robots), len(rooms))
 
     def record_round(self, segment: str, strategy: str, plan: Assignment,
                      infos: list[RoomInfo]) -> None:

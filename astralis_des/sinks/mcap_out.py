@@ -24,6 +24,7 @@ import numpy as np
 from astralis_des.errors import InputError
 from astralis_des.kernel.events import Record
 from astralis_des.sinks import ros_messages as ros
+from astralis_des.world.geometry import Box
 from astralis_des.world.model import BLOCK
 
 if TYPE_CHECKING:
@@ -131,7 +132,7 @@ def markers(ty: ros.Types, sim: Simulation) -> Any:
         boxes.append(("rooms", sim.world.rooms[rid].box, (float(risk), 0.3, 0.3, 0.15)))
     for placed in sim.scene.furnished():
         centre, size = np.asarray(placed.center, dtype=float), np.asarray(placed.size)
-        boxes.append(("furniture", _Box(centre - size / 2, centre + size / 2),
+        boxes.append(("furniture", Box(tuple(centre - size / 2), tuple(centre + size / 2)),
                       (0.55, 0.35, 0.17, 1.0)))
     stamp = ros.header(ty, 0.0, "map")
     out = []
@@ -152,8 +153,3 @@ def markers(ty: ros.Types, sim: Simulation) -> Any:
                 0, dtype=np.uint8)),
             mesh_use_embedded_materials=False))
     return ty.visualization_msgs__MarkerArray(markers=out)
-
-
-class _Box:
-    def __init__(self, lo: np.ndarray, hi: np.ndarray) -> None:
-        self.lo, self.hi = lo, hi
