@@ -91,7 +91,7 @@ class Observer:
             out[i, 6] = robot.heading
             handler = sim.handler(rid)
             hold = run.holds.get(rid)
-            out[i, 7] = handler.current is not None or bool(handler.queued)
+            out[i, 7] = not run.idle(rid)
             out[i, 8] = robot.faulted
             out[i, 9] = hold is not None and not hold.processed
             out[i, 10] = rid in run.asked

@@ -115,16 +115,17 @@ class EpisodeRun:
         if poke is None or poke.triggered:
             return
         if kind in HEARD or (kind == "task_finished" and (
-                record.get("room") in self.inflight or self._idle(record["robot"]))):
+                record.get("room") in self.inflight or self.idle(record["robot"]))):
             poke.succeed()
 
-    def _idle(self, robot_id: str) -> bool:
+    def idle(self, robot_id: str) -> bool:
+        """Whether the robot has nothing running and nothing queued."""
         handler = self.sim.handler(robot_id)
         return handler.current is None and not handler.queued
 
     def _free(self, robot: Robot) -> bool:
         hold = self.holds.get(robot.id)
-        return not robot.faulted and self._idle(robot.id) and (hold is None or hold.processed)
+        return not robot.faulted and self.idle(robot.id) and (hold is None or hold.processed)
 
     def _anyone_may(self, agents: list[Robot], rooms: list[str]) -> bool:
         return bool(self.sim.allowed(agents, rooms, self.sim.tried).any())
