@@ -50,6 +50,8 @@ PARAMS: dict[str, dict[str, Param]] = {
     "spiral_outward": {"spacing": _SPACING},
     "sweep_horizontal": {"spacing": _SPACING},
     "sweep_vertical": {"spacing": _SPACING},
+    "take_off": {},
+    "land": {},
     "inspect": {"inset": Param("m from the walls of the walk round the room", 1.0, 0.0, 20.0)},
     "sneak_peek": {"dwell": Param("s looking in from the door", 5.0, 0.0, 600.0)},
     "observe_corridor": {"dwell": Param("s looking from each spot of the corridor", 1.0, 0.0,

@@ -27,6 +27,8 @@ class KindDefaults:
     accel: float | None = None  # m/s^2 speeding up and slowing down; None for a walker
     turn_rate: float | None = None  # rad/s turning on the spot (a non-holonomic robot)
     footprint: tuple[float, float] | None = None  # m, length and width of a long body
+    rest: float | None = None  # m above the floor of its sensor when landed; None: it walks
+    # or drives (its sensor is always at ``height``)
 
     @property
     def swept_radius(self) -> float | None:
@@ -36,11 +38,19 @@ class KindDefaults:
         return math.hypot(self.footprint[0] / 2, self.footprint[1] / 2)
 
 
+UAV_BODY_HALF_HEIGHT = 0.06  # m: half the hexacopter's body (its collision cylinder)
+UAV_FLIGHT_HEIGHT = 1.975  # m: the default world's flight height (see world.flight)
+UAV_REST = 0.07  # m: its centre standing on the floor (half its body and a centimetre)
+CLIMB_SPEED = 1.0  # m/s: a UAV taking off or landing
+
 KIND_DEFAULTS: dict[str, KindDefaults] = {
-    # A gimballed camera 75 degrees down: at 1.5 m over the floor it sees a strip about
-    # 3 m wide below the craft, mostly ahead of it.
+    # A gimballed camera 75 degrees down: at 2 m over the floor it sees a strip about 4 m
+    # wide below the craft, mostly ahead of it. Indoors it flies over the heads of standing
+    # people and under the door lintels (:func:`astralis_des.world.flight.flight_height`):
+    # ``height`` is the flight height where the world sets none. It starts and ends landed.
     "uav": KindDefaults(speed=1.5, camera=CameraDefaults(None, 90.0, 75.0, True, True),
-                        height=1.5, distance="l2", sensors=("camera", "imu"), accel=2.0),
+                        height=UAV_FLIGHT_HEIGHT, distance="l2", sensors=("camera", "imu"),
+                        accel=2.0, rest=UAV_REST),
     # A forward camera on the body, and a lidar the local planner slows down for.
     "ugv": KindDefaults(speed=1.0, camera=CameraDefaults(None, 60.0, 0.0, False, False),
                         height=0.5, distance="manhattan", sensors=("camera", "lidar", "imu"),

@@ -72,7 +72,7 @@ def test_table_ii_location(client: Client, server: Background) -> None:
 
 def test_table_ii_robot(client: Client) -> None:
     robot = client.robot("uav2")
-    assert robot["type"] == "uav" and robot["pose"] == [92.0, 60.0, 1.5]
+    assert robot["type"] == "uav" and robot["pose"] == [92.0, 60.0, 0.07]  # landed
     assert robot["command"] is None and robot["state"] == "idle"
     with pytest.raises(ApiError, match=r"no robot 'uav9'; did you mean 'uav[12]'") as err:
         client.robot("uav9")
@@ -90,9 +90,11 @@ def test_status_queue_and_events(client: Client) -> None:
     client.enqueue("uav1", "hover", params={"duration": 4})
     later = client.events(after=first["next"])
     assert [e["kind"] for e in later["events"]] == ["command", "task_queued"]
-    client.step(by=5.0)
+    client.step(by=7.0)  # it takes off (2.4 s), then hovers 4 s
     kinds = [e["kind"] for e in client.events(since=4.0, robot="uav1")["events"]]
     assert kinds == ["task_finished"]
+    assert [e["kind"] for e in client.events(robot="uav1")["events"]] == [
+        "command", "task_queued", "task_started", "took_off", "task_finished"]
     page = client.events(kinds=["task_started", "task_finished"], limit=1)
     assert [e["kind"] for e in page["events"]] == ["task_started"]
     assert [e["kind"] for e in client.events(after=page["next"],
@@ -294,7 +296,10 @@ def test_a_team_without_automatic_rounds_waits(manual: Mission) -> None:
 def test_physics_poses_come_from_the_bodies(manual: Mission) -> None:
     background = Background(manual.with_changes(fidelity="physics"), running=False)
     with Client(background.start(), timeout=10.0) as client:
+        client.enqueue("uav1", "take_off")
+        client.step(by=3.0)
         start = client.robot("uav1")["pose"]
+        assert start[2] == pytest.approx(1.975, abs=0.05)  # up at its flight height
         client.enqueue("uav1", "move", params={"x": start[0], "y": start[1] + 2.0})
         client.step(by=0.5)
         moving = client.robot("uav1")
@@ -361,7 +366,7 @@ def test_bad_parameters_are_an_error_reply_and_the_robot_is_untouched(
     assert caught.value.code == "bad_args"
     assert client.robot("uav1")["queued"] == 0 and client.robot("uav1")["task"] is None
     client.enqueue("uav1", "hover", params={"duration": 2})
-    client.step(by=3.0)
+    client.step(by=5.0)  # take-off and hover
     assert client.robot("uav1")["task"] is None
 
 

@@ -201,7 +201,8 @@ def test_allocation_metrics_of_the_default_mission_match_its_event_log(tmp_path:
     sim = Simulation(mission, out_dir=tmp_path)
     result = sim.run()
     events = [json.loads(line) for line in (tmp_path / "events.jsonl").read_text().splitlines()]
-    searches = [e for e in events if e["kind"] == "task_finished" and e["action"] != "move"
+    searches = [e for e in events if e["kind"] == "task_finished" and e["room"]
+                and e["action"] != "move"
                 and e["status"] == "succeeded"]
     got = allocation_metrics(sim, result, 0.5, 0.5)
     assert got["makespan"] == pytest.approx(max(e["t"] for e in searches), abs=1e-6)

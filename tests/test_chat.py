@@ -154,7 +154,8 @@ def test_lines_the_chat_answers_itself(team: Team, line: str, op: str,
     ("op1 sneak-peek A.1.1.1",
      "op1 is a human: it cannot sneak-peek; it can move, inspect, search"),
     ("uav1 serch A.2.1.3",
-     "uav1 has no command 'serch'; did you mean 'search'? (it can move, search, hover)"),
+     "uav1 has no command 'serch'; did you mean 'search'? (it can move, search, hover, "
+     "take-off, land)"),
     ("op1 move", "op1 move needs a room or x y: op1 move ROOM|X Y"),
     ("uav1 search A.2.1.3 inward outward",
      "uav1 search: one of inward, outward, horizontal, vertical, not inward and outward"),
@@ -216,7 +217,7 @@ def test_status_shows_the_team_and_the_time(chat: Chat) -> None:
     rows = {line.split()[0]: line.split() for line in text.splitlines()[2:]}
     assert {rid: row[1] for rid, row in rows.items()} == ROBOTS
     assert all(row[2] == "idle" for row in rows.values())
-    assert "(90.0, 60.0, 1.5)" in text  # uav1 where the mission starts it
+    assert "(90.0, 60.0, 0.1)" in text  # uav1 where the mission starts it, landed
 
 
 def test_a_search_is_queued_then_listed_then_cancelled(chat: Chat, client: Client) -> None:
@@ -412,7 +413,7 @@ def test_bad_parameters_are_refused_when_given_and_the_robot_stays_usable(
         "error: spiral_inward has no parameter 'mode' (its parameters: spacing)")
     assert client.status()["robots"]["uav1"]["queued"] == 0  # nothing was queued
     assert chat.text("uav1 hover 3") == "queued task 1 for uav1: hover duration=3 (next to run)"
-    assert chat.text("step 5") == "t = 5.0 s"  # the clock goes on
+    assert chat.text("step 6") == "t = 6.0 s"  # the clock goes on (take-off, hover)
     assert client.robot("uav1")["task"] is None  # the hover ran and ended
     assert chat.text("queue uav1") == "uav1: nothing running, nothing queued"
 

@@ -181,8 +181,12 @@ def test_hold_hovers_a_uav_and_stands_a_person_still() -> None:
     sim = env.mission_run.sim
     hovers = [r for r in sim.log.of_kind("task_queued") if r["action"] == "hover"]
     assert [r["robot"] for r in hovers] == ["uav1", "uav2"]
-    assert sim.env.now == pytest.approx(7.0)  # hovers and holds end together: all asked
-    assert env.mission_run.asked == ["uav1", "uav2", "ugv1", "op1"]
+    assert sim.env.now == pytest.approx(7.0)  # the holds end: the two on foot asked
+    assert env.mission_run.asked == ["ugv1", "op1"]
+    for _ in range(2):
+        env.step(HOLD)
+    assert sim.env.now == pytest.approx(9.405)  # the UAVs took off (2.405 s), hovered 7 s
+    assert env.mission_run.asked == ["uav1", "uav2"]
 
 
 def test_the_default_reward_adds_up_to_the_missions_figures() -> None:

@@ -43,7 +43,9 @@ def test_an_external_coordinator_finds_the_target_reproducibly(urban_search: Mis
     assert searched and "A.1.2.1" not in searched  # found in A.1.2.1 while searching it
     events = [json.loads(x) for x in (tmp_path / "one" / "events.jsonl").read_text()
               .splitlines()]
-    assert {e["origin"] for e in events if e["kind"] == "task_queued"} == {"api"}
+    origins = {(e["origin"], e["action"]) for e in events if e["kind"] == "task_queued"}
+    assert {o for o, _ in origins} == {"api", "mission"}  # the UAVs land at the end
+    assert {a for o, a in origins if o == "mission"} == {"land"}
     assert [e["kind"] for e in events].count("assignment") == 0
     detection = next(e for e in events if e["kind"] == "detection")
     assert detection["target_room"] == "A.1.2.1"

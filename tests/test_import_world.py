@@ -164,5 +164,6 @@ def test_autzen_recon_is_the_same_mission_in_physics(recon: tuple[Run, Run]) -> 
         for r in kinematic.rounds]
     assert physics.outcome == kinematic.outcome == "found"
     assert physics.found_by == kinematic.found_by
-    assert not [e for e in physics.events
-                if e["kind"] == "task_finished" and e["status"] != "succeeded"]
+    assert not [e for e in physics.events  # (tasks still running at the end: cancelled)
+                if e["kind"] == "task_finished" and e["status"] != "succeeded"
+                and e["message"] != "mission ended"]

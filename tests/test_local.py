@@ -12,6 +12,8 @@ from astralis_des.world.scene import Mover
 
 ROOT = Path(__file__).resolve().parents[1]
 CORRIDOR_Y = 78.25  # centre line of building A's ground-floor corridor
+LOW = 1.5  # m: a UAV flown at head height, which must avoid walkers (by default it flies over
+# them, at 1.975 m)
 
 
 def corridor_mission(team: list[dict]) -> Simulation:
@@ -69,7 +71,8 @@ def test_a_walker_crossing_the_ugvs_path_is_let_through() -> None:
 def _flight_past_avatar(uav_y: float, avatar_y: float) -> Simulation:
     """A UAV flies east along the corridor at ``uav_y`` while an avatar walks west at
     ``avatar_y``, 1.05 m to its left, over the same stretch (x 68.4 to 71.6)."""
-    sim = corridor_mission([{"id": "uav1", "kind": "uav", "start": [64.5, uav_y, 0.0]}])
+    sim = corridor_mission([{"id": "uav1", "kind": "uav", "start": [64.5, uav_y, 0.0],
+                             "height": LOW}])
     add_walker(sim, [(71.6, avatar_y), (68.4, avatar_y)])
     sim.start()
     done = sim.enqueue("uav1", "move", params={"x": 76.0, "y": uav_y})
@@ -106,7 +109,7 @@ def test_a_uav_and_a_walker_cross_a_doorway_head_on_without_touching(
     inward = 1.0 if y > CORRIDOR_Y else -1.0
     room = (x, y + inward * 3.4)
     sim = corridor_mission([
-        {"id": "uav1", "kind": "uav", "start": [x + 2.0, CORRIDOR_Y, 0.0]},
+        {"id": "uav1", "kind": "uav", "start": [x + 2.0, CORRIDOR_Y, 0.0], "height": LOW},
         {"id": "op1", "kind": "human", "start": [x - 0.8, room[1], 0.0]},
     ])
     sim.start()

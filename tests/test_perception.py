@@ -77,7 +77,10 @@ def test_a_hovering_uav_looks_around_and_keeps_the_detection_frame() -> None:
     sim = sim_with({"id": "uav1", "kind": "uav", "start": [70.0, 81.0, 0]},
                    target=[70.0, 82.6, 0.5])
     robot = sim.robots["uav1"]
-    assert robot.heading == 0.0
+    sim.start()
+    sim.enqueue("uav1", "take_off")  # it starts on the ground
+    sim.advance(3.0)
+    assert robot.airborne and robot.heading == 0.0
     hit = sim.cosim.look(robot, sim.sensor)
     assert hit is not None and hit.pixels is not None and hit.pixels >= 40
     frames = sim.cosim.perception.frames
@@ -119,10 +122,13 @@ def test_the_imu_of_a_flying_uav_reads_one_g_up() -> None:
         timeline=[{"at": 0.0, "event": "command", "robot": "uav1", "action": "move",
                    "room": "A.1.1.3"}], assignment={"search": ["A.1.2"]})
     sim = Simulation(mission)
-    sim.run()
+    result = sim.run()
     trace = sim.cosim.perception.imu_traces["uav1"]
-    assert len(trace.readings) > 20
-    force = np.array([r.specific_force for r in trace.readings])
+    up = next(e["t"] for e in result.events if e["kind"] == "took_off")
+    arrived = next(e["t"] for e in result.events if e["kind"] == "task_finished")
+    cruise = [r for t, r in zip(trace.times, trace.readings, strict=True) if up < t < arrived]
+    assert len(cruise) > 20  # (taking off and landing, it reads more and less than 1 g)
+    force = np.array([r.specific_force for r in cruise])
     assert np.median(force[:, 2]) == pytest.approx(9.81, abs=0.3)
     assert force[:, 2].min() > 9.0 and np.median(np.abs(force[:, :2])) < 0.5
     gaps = np.diff(trace.times)

@@ -10,8 +10,8 @@ from astralis_des.registry import Registry, UnknownEntry
 
 def test_table_i_actions_are_registered_per_kind() -> None:
     """Every action of the paper's Table I, plus the human's move and inspect."""
-    assert actions_for("uav") == ["hover", "move", "spiral_inward", "spiral_outward",
-                                  "sweep_horizontal", "sweep_vertical"]
+    assert actions_for("uav") == ["hover", "land", "move", "spiral_inward", "spiral_outward",
+                                  "sweep_horizontal", "sweep_vertical", "take_off"]
     assert actions_for("ugv") == ["move", "observe_corridor", "sneak_peek"]
     assert actions_for("human") == ["inspect", "move"]
 

@@ -16,12 +16,13 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from astralis_des import InputError, Mission, RunResult, Simulation, load_mission
 from astralis_des.assignment import table4_action
 from astralis_des.kernel.robot import Motion
-from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.kinds import CLIMB_SPEED, KIND_DEFAULTS
 
 UAV = KIND_DEFAULTS["uav"]
 
@@ -33,7 +34,10 @@ def flown_in(result: RunResult, robot: str, seconds: float) -> float:
     sim = Simulation(load_mission(MISSION))
     here = sim.robots[robot]
     points = route_to(sim, here, start["room"])
-    return Motion(points, UAV.speed, accel=UAV.accel).travelled(seconds)
+    up = Motion(np.array([here.pose, here.pose + [0.0, 0.0, here.height - here.pose[2]]]),
+                CLIMB_SPEED, accel=UAV.accel)  # it takes off first
+    return up.length + Motion(points, UAV.speed, accel=UAV.accel).travelled(
+        seconds - up.duration)
 
 
 def route_to(sim: Simulation, robot: Any, room: str) -> Any:
@@ -287,7 +291,9 @@ def test_found_iff_detection(mission: Mission, changes: dict[str, Any]) -> None:
         assert result.time_to_find == hit["t"]
         assert result.found_by == hit["robot"]
         assert hit["target_room"] == result.target["room"]
-        assert result.end_time == pytest.approx(hit["t"], abs=1e-6)
+        landed = [e["t"] for e in events(result, "landed")]  # the UAVs land, then it ends
+        assert landed and min(landed) > hit["t"]
+        assert result.end_time == pytest.approx(max(landed), abs=1e-6)
     else:
         assert result.time_to_find is None
     assert result.events[-1]["kind"] == "mission_end"

@@ -23,6 +23,6 @@ from astralis_des.actions import human, move, uav, ugv  # noqa: E402,F401  (they
 
 # Actions that take no room (the others search, peek into or go to one; ``move`` also takes
 # a point: ``x`` and ``y`` params).
-ROOMLESS = frozenset({"hover"})
+ROOMLESS = frozenset({"hover", "take_off", "land"})
 
 __all__ = ["ACTIONS", "ROOMLESS", "Action", "actions_for"]

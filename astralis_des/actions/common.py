@@ -12,13 +12,15 @@ from astralis_des import detection
 from astralis_des.kernel.contracts import Context
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kernel.tasks import ActionResult, Task, TaskStatus
-from astralis_des.kinds import KIND_DEFAULTS, TARGET_HEIGHT
+from astralis_des.kinds import CLIMB_SPEED, KIND_DEFAULTS, TARGET_HEIGHT
 from astralis_des.planning.navigator import Route, level_legs
 from astralis_des.world.geometry import FloatArray
 from astralis_des.world.model import Room
 
 DOOR_OFFSET = 0.6  # m in front of a door's wall: where robots stop by a door
 TURN_MARGIN = 0.1  # m kept between a wall and the circle a body sweeps turning on the spot
+LANDING_CLEAR = 0.45  # m: half the side of the square of floor a landing UAV needs free
+LANDING_RINGS = (0.0, 0.6, 1.2, 1.8, 2.4)  # m around a UAV where it looks for that square
 LOOK_AROUND = 2.0  # s spent looking round a room that cannot be searched by its pattern
 ActionGen = Generator[simpy.Event, Any, ActionResult]
 StepGen = Generator[simpy.Event, Any, float]
@@ -59,9 +61,75 @@ def route(ctx: Context, robot: Robot,
                                at=now if robot.kind == "uav" else None)
 
 
-def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> StepGen:
-    """Follow ``points``; when sensing, report the target the moment it comes into view."""
+def climb(ctx: Context, robot: Robot, height: float) -> StepGen:
+    """Fly straight up or down to ``height`` above the floor under the robot."""
+    here = robot.position(ctx.env.now)
+    there = here.copy()
+    there[2] = ctx.world.floor_below(here) + height
     before = robot.distance
+    done = ctx.cosim.execute(robot, Motion(np.vstack([here, there]), CLIMB_SPEED,
+                                           accel=robot.accel, heading=robot.heading))
+    outcome = yield done
+    ctx.cosim.halt(robot)
+    if not outcome.ok:
+        raise MotionFailed(outcome.reason, outcome.fault)
+    return robot.distance - before
+
+
+def take_off(ctx: Context, robot: Robot) -> StepGen:
+    """A UAV on the ground climbs to its flight height before it goes anywhere (a
+    ``took_off`` event); nothing for a robot already flying or one that does not fly."""
+    if robot.airborne:
+        return 0.0
+    distance = yield from climb(ctx, robot, robot.height)
+    robot.airborne = True
+    ctx.log.emit("took_off", robot.id, height=round(robot.height, 3))
+    return distance
+
+
+def landing_spot(ctx: Context, robot: Robot) -> FloatArray:
+    """Where a UAV can come straight down: over its own spot if the column under it is free
+    of walls, furniture and people who stay put, else over the nearest free one on rings
+    around it that it can fly to in a straight line (its own spot if none is)."""
+    here = robot.position(ctx.env.now)
+    floor = ctx.world.floor_below(here)
+    room = ctx.world.room_at((here[0], here[1], floor + 0.5))
+    boxes = ctx.sensor.scene.blockers([room.id] if room is not None else [])
+    for reach in LANDING_RINGS:
+        angles = np.linspace(0.0, 2 * np.pi, 1 if reach == 0 else 12, endpoint=False)
+        for angle in angles:
+            spot = here + reach * np.array([np.cos(angle), np.sin(angle), 0.0])
+            lo = np.array([spot[0] - LANDING_CLEAR, spot[1] - LANDING_CLEAR, floor + 0.02])
+            hi = np.array([spot[0] + LANDING_CLEAR, spot[1] + LANDING_CLEAR, here[2]])
+            if np.any(np.all((boxes[:, 0] < hi) & (boxes[:, 1] > lo), axis=1)):
+                continue
+            if reach == 0 or bool(ctx.sensor.scene.line_of_sight(here, spot)[0]):
+                return spot
+    return here
+
+
+def land(ctx: Context, robot: Robot) -> StepGen:
+    """A flying UAV comes straight down onto the floor (a ``landed`` event): under it, or
+    beside it where the floor under it is taken (:func:`landing_spot`)."""
+    rest = KIND_DEFAULTS[robot.kind].rest
+    if not robot.airborne or rest is None:
+        return 0.0
+    here, spot = robot.position(ctx.env.now), landing_spot(ctx, robot)
+    distance = 0.0
+    if float(np.linalg.norm(spot - here)) > 1e-6:
+        distance = yield from traverse(ctx, robot, np.vstack([here, spot]), sense=False)
+    robot.airborne = False  # from here on it is coming down (stopped, it takes off again)
+    distance += yield from climb(ctx, robot, rest)
+    ctx.log.emit("landed", robot.id, position=[round(float(v), 3)
+                                               for v in robot.position(ctx.env.now)])
+    return distance
+
+
+def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> StepGen:
+    """Follow ``points``; when sensing, report the target the moment it comes into view.
+    A UAV on the ground takes off first."""
+    before = robot.distance
+    yield from take_off(ctx, robot)
     robot.plans.append((ctx.env.now, np.asarray(points, dtype=float)))
     motion = Motion(points, robot.speed, accel=robot.accel, turn_rate=robot.turn_rate,
                     heading=robot.heading)
@@ -79,7 +147,8 @@ def traverse(ctx: Context, robot: Robot, points: FloatArray, sense: bool) -> Ste
 
 
 def dwell(ctx: Context, robot: Robot, seconds: float) -> StepGen:
-    """Stay and look around from where the robot is."""
+    """Stay and look around from where the robot is (a UAV on the ground takes off first)."""
+    yield from take_off(ctx, robot)
     ctx.cosim.halt(robot)
     hit = ctx.cosim.look(robot, ctx.sensor)
     if hit is not None:

@@ -9,10 +9,12 @@ from astralis_des.actions.common import (
     dwell,
     failed,
     footprint_spacing,
+    land,
     plane_to_floor,
     result,
     room_of,
     search_path,
+    take_off,
 )
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task, TaskStatus
@@ -30,6 +32,26 @@ def hover(ctx: Context, robot: Robot, task: Task) -> ActionGen:
     seconds = float(task.param("duration", 10.0))
     yield from dwell(ctx, robot, seconds)
     return result(TaskStatus.SUCCEEDED, f"hovered {seconds:g} s")
+
+
+@ACTIONS.register(("uav", "take_off"))
+def take_off_action(ctx: Context, robot: Robot, task: Task) -> ActionGen:
+    """Climb straight up from the ground to the flight height (a UAV on the ground also
+    does this by itself before any other action)."""
+    flying = robot.airborne
+    distance = yield from take_off(ctx, robot)
+    return result(TaskStatus.SUCCEEDED, "already flying" if flying else "took off",
+                  distance=distance)
+
+
+@ACTIONS.register(("uav", "land"))
+def land_action(ctx: Context, robot: Robot, task: Task) -> ActionGen:
+    """Come straight down onto the floor below and stay there (the next action takes off
+    again). UAVs land by themselves when the mission ends."""
+    flying = robot.airborne
+    distance = yield from land(ctx, robot)
+    return result(TaskStatus.SUCCEEDED, "landed" if flying else "already on the ground",
+                  distance=distance)
 
 
 def _pattern(name: str, inward: bool | None = None, axis: int | None = None):  # type: ignore[no-untyped-def]

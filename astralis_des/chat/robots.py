@@ -62,6 +62,10 @@ robot_verb("uav", RobotVerb("search", "spiral_inward", "search a room: a spiral 
                             variants=SEARCHES))
 robot_verb("uav", RobotVerb("hover", "hover", "hold position and look around (default 10 s)",
                             room="none", number="duration"))
+robot_verb("uav", RobotVerb("take-off", "take_off", "climb from the ground to the flight "
+                            "height", room="none"))
+robot_verb("uav", RobotVerb("land", "land", "come down onto the floor below (the next action "
+                            "takes off again)", room="none"))
 robot_verb("ugv", RobotVerb("sneak-peek", "sneak_peek", "look into a room from its door"))
 robot_verb("ugv", RobotVerb("observe", "observe_corridor", "watch a room's corridor"))
 robot_verb("human", RobotVerb("inspect", "inspect", "walk into a room and inspect it"))

@@ -383,8 +383,9 @@ class PhysicsCoSim:
             body = self.drivers[rid].body
             for c in self.client.call("getContactPoints", bodyA=body):
                 other = self.names.get(c[2], "object")
-                if robot.kind != "uav" and other in FLOORS and c[7][2] > SUPPORT:
-                    continue  # wheels or feet on a floor
+                if (robot.kind != "uav" or not robot.airborne) and other in FLOORS \
+                        and c[7][2] > SUPPORT:
+                    continue  # wheels or feet on a floor, a UAV taking off or landing
                 key = (rid, other)
                 now.add(key)
                 impulses[key] = impulses.get(key, 0.0) + c[9] * self.client.dt

@@ -78,6 +78,8 @@ class EpisodeRun:
         for segment, rooms in groups(sim.mission):
             self.segment, self.pending = segment, list(rooms)
             while self.pending:
+                if sim.ended:  # the UAVs are landing: no more decisions
+                    return "ended"
                 for _ in range(SETTLE):  # the instant's other events first, so that every
                     if sim.env.peek() != sim.env.now:  # robot free at this time is asked at
                         break  # once (bounded: the physics stepper also waits for them)

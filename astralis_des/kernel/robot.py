@@ -118,6 +118,7 @@ class Robot:
     accel: float | None = None  # m/s^2; None: starts and stops at once
     turn_rate: float | None = None  # rad/s on the spot, for a non-holonomic robot
     heading: float = 0.0
+    airborne: bool = True  # false for a UAV on the ground: it takes off before it moves
     distance: float = 0.0
     busy_time: float = 0.0
     trail_t: list[float] = field(default_factory=list)

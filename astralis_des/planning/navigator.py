@@ -35,6 +35,8 @@ RIM = 0.25  # m between the points a rectangular footprint is checked at, along 
 NUDGE = 0.6  # m: how far a leg's end in collision may be moved to a free point
 CELL = 0.1  # m, walkers' floor grid
 LIFT_SLACK = 0.05  # m above the clearance a UAV's point lifted over furniture is put
+DUCK_STEP = 0.05  # m: the heights a UAV tries, one below the other, to pass under a lintel
+DUCK_LOWEST = 1.0  # m over the floor: it flies no lower to pass under one
 
 
 @dataclass(frozen=True)
@@ -108,6 +110,10 @@ class Navigator:
             a = out[-1]
             if float(np.linalg.norm(b - a)) < 1e-9 or self._leg_free(robot, a, b, radius):
                 out.append(b)
+                continue
+            ducked = self._duck(robot, a, b, radius) if robot.kind == "uav" else None
+            if ducked is not None:
+                out.extend(ducked[1:])
                 continue
             detour, reason = self._plan_leg(robot, a, b, radius)
             if detour is None:
@@ -253,6 +259,22 @@ class Navigator:
         boxes, margins = boxes[near], margins[near]
         grown = np.stack([boxes[:, 0] - margins[:, None], boxes[:, 1] + margins[:, None]], axis=1)
         return not bool(segments_hit_boxes(a[None, :], b[None, :], grown)[0])
+
+    def _duck(self, robot: Robot, a: FloatArray, b: FloatArray,
+              radius: float) -> FloatArray | None:
+        """A UAV's level leg blocked overhead (a door's lintel): the same leg flown lower,
+        coming down before it and climbing back after, at the highest height that is clear
+        (not below ``DUCK_LOWEST`` over the floor); ``None`` if none is."""
+        if abs(float(a[2] - b[2])) > 1e-6:
+            return None
+        lowest = self.world.floor_below(a - np.array([0.0, 0.0, robot.height])) + DUCK_LOWEST
+        for z in np.arange(float(a[2]) - DUCK_STEP, lowest - 1e-9, -DUCK_STEP):
+            a2, b2 = a.copy(), b.copy()
+            a2[2] = b2[2] = z
+            if self._leg_free(robot, a2, b2, radius) and self._leg_free(robot, a, a2, radius) \
+                    and self._leg_free(robot, b2, b, radius):
+                return np.array([a, a2, b2, b])
+        return None
 
     # -- planning a leg --------------------------------------------------------------------
     def _plan_leg(self, robot: Robot, a: FloatArray, b: FloatArray,

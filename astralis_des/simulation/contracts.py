@@ -30,6 +30,9 @@ class Run(Host, Protocol):
     tried: dict[str, set[str]]  # room -> kinds whose search saw too little of it
     finished: list[tuple[Task, ActionResult]]
 
+    @property
+    def ended(self) -> bool: ...
+
     def handler(self, robot_id: str) -> TaskHandler: ...
     def enqueue(self, robot_id: str, action: str, room: str | None = None,
                 params: dict[str, Any] | None = None, *, origin: str = "assignment",

@@ -35,10 +35,13 @@ from astralis_des.simulation.result import RunResult, build_result
 from astralis_des.simulation.timeline import scheduled, search
 from astralis_des.streams import stream
 from astralis_des.view import View
+from astralis_des.world.flight import flight_height
 from astralis_des.world.scene import Scene
 
 log = logging.getLogger(__name__)
 Progress = Callable[[float, float], None]
+WIND_DOWN = frozenset({"found", "not_found", "team_lost"})  # ends after which the UAVs land
+LANDING_LIMIT = 60.0  # s of simulated time the wind-down may take
 # The process that searches the mission's rooms (the timeline's rounds by default; an
 # environment's agents decide them instead): it returns why the search stopped.
 Searcher = Callable[["Simulation"], Generator[simpy.Event, Any, str]]
@@ -83,6 +86,7 @@ class Simulation:
         self._limit: simpy.Event | None = None
         self._sinks: Any = None
         self._wall0 = time.perf_counter()
+        self.flight_height = flight_height(self.world, mission.clutter_catalogue())
         self.robots = {m.id: self._make_robot(m) for m in spec.team}
         self.navigator = Navigator(self.world, self.scene, spec)
         self.cosim = load_fidelity(spec.fidelity)(self)
@@ -101,14 +105,15 @@ class Simulation:
 
     def _make_robot(self, member: MemberSpec) -> Robot:
         d = KIND_DEFAULTS[member.kind]
-        height = member.height or d.height
+        flies = d.rest is not None  # a UAV: it starts landed, and flies at the world's height
+        height = member.height or (self.flight_height if flies else d.height)
         if isinstance(member.start, str):
             start = np.array(self.world.rooms[member.start].center)
         else:
             start = np.array(member.start, dtype=float)
-        start = start + np.array([0.0, 0.0, height])
+        start = start + np.array([0.0, 0.0, d.rest if d.rest is not None else height])
         robot = Robot(member.id, member.kind, member.speed or d.speed, view_of(member),
-                      height, start, accel=d.accel, turn_rate=d.turn_rate)
+                      height, start, accel=d.accel, turn_rate=d.turn_rate, airborne=not flies)
         robot.trail_t.append(0.0)
         robot.trail_p.append(start.copy())
 
@@ -338,6 +343,8 @@ class Simulation:
             outcome = "time_limit"                                  # as soon as it exists
         else:
             outcome = "interrupted"
+        if outcome in WIND_DOWN:
+            self._wind_down()
         for robot in self.robots.values():
             self.cosim.halt(robot)
             if robot.id in self._started:  # still at work when the mission ended
@@ -349,6 +356,22 @@ class Simulation:
             self._sinks.close(result)
         log.info("%s: %s at t=%.1f s", self.mission.spec.name, outcome, self.env.now)
         return result
+
+
+    def _wind_down(self) -> None:
+        """The mission is over: each robot's tasks end (``cancelled``, "mission ended") and
+        the UAVs in the air land where they are (``land`` tasks), within ``LANDING_LIMIT``."""
+        waits = []
+        for robot in self.robots.values():
+            handler = self.handler(robot.id)
+            waits += [handler.done_event(t.id) for t in handler.cancel(reason="mission ended")]
+        waits += [self.enqueue(r.id, "land", origin="mission") for r in self.robots.values()
+                  if r.airborne and not r.faulted and KIND_DEFAULTS[r.kind].rest is not None]
+        if waits:
+            over = simpy.AnyOf(self.env, [simpy.AllOf(self.env, waits),
+                                          self.env.timeout(LANDING_LIMIT)])
+            while not over.triggered:  # an earlier advance(until)'s stop may still be due
+                self.env.run(until=over)
 
 
 def view_of(member: MemberSpec) -> View | None:

@@ -47,6 +47,8 @@ def search(sim: Run) -> Generator[simpy.Event, Any, str]:
     for segment, rooms in groups(sim.mission):
         pending = list(rooms)
         while pending:
+            if sim.ended:  # the UAVs are landing: no more rounds
+                return "ended"
             agents = [r for r in sim.robots.values() if not r.faulted]
             if not agents:
                 sim.log.emit("team_lost", segment=segment)
@@ -68,6 +70,8 @@ def book_search(sim: Run, pending: list[str], attempts: Counter[str],
                 searcher: dict[str, str], room: str, done: simpy.Event) -> None:
     """A search that ended: its room searched, left pending for another kind (seen too
     little) or another robot (its own broke down), or tried once more, up to the limit."""
+    if sim.ended:  # cut short by the mission's end: nothing to book
+        return
     outcome = cast(ActionResult, done.value)
     robot = sim.robots[searcher[room]]
     if outcome.ok and not _undercovered(sim, room, robot, outcome):

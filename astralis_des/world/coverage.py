@@ -12,32 +12,46 @@ from astralis_des.world.geometry import Box, FloatArray
 
 
 def spiral(box: Box, spacing: float, inward: bool = True,
-           margin: float | None = None) -> FloatArray:
-    """Rectangular rings, outermost first, ``spacing`` apart; reversed when outward. The
-    outermost ring runs ``spacing / 2`` inside the walls, or ``margin`` when that is nearer."""
-    x0, y0, x1, y1 = box.lo[0], box.lo[1], box.hi[0], box.hi[1]
-    half = min(x1 - x0, y1 - y0) / 2
-    pts: list[tuple[float, float]] = []
-    k = min(spacing / 2, half, margin if margin is not None else np.inf)
-    while k <= half + 1e-9:
-        a, b, c, d = x0 + k, y0 + k, x1 - k, y1 - k
-        if c - a < 1e-6 or d - b < 1e-6:  # the ring collapsed to a line: the spiral's centre
-            pts += [(a, b), (c, d)]
-            break
-        pts += [(a, b), (c, b), (c, d), (a, d), (a, min(b + spacing, d))]
-        k += spacing
+           margin: float | None = None, min_turns: int = 2) -> FloatArray:
+    """A rectangular spiral from the walls to the centre (``inward``) or from the centre to the
+        walls: each side runs a quarter of a ring's spacing nearer the centre than the one before,
+    so the path never crosses itself and its corners come ever nearer the centre (farther,
+    outward). Rings are ``spacing`` apart (the camera's footprint), closer when needed to
+    make at least ``min_turns`` turns; the first side runs ``spacing / 2`` inside the walls,
+    or ``margin`` when that is nearer, and never more than half way to the centre."""
+    lo, hi = np.array(box.lo[:2], dtype=float), np.array(box.hi[:2], dtype=float)
+    if hi[1] - lo[1] > hi[0] - lo[0]:  # drawn with the long axis along x, so that the last
+        flipped = Box((box.lo[1], box.lo[0], box.lo[2]), (box.hi[1], box.hi[0], box.hi[2]))
+        path = spiral(flipped, spacing, inward, margin, min_turns)  # leg runs along it
+        return path[:, ::-1].copy()
+    half = float(min(hi - lo)) / 2
+    k0 = min(spacing / 2, half / 2, margin if margin is not None else np.inf)
+    turns = max(min_turns, int(np.ceil((half - k0) / spacing - 1e-9)))
+    step = (half - k0) / turns  # inset gained per turn; a quarter of it per side
+    # Sides in turn: south (east-going), east, north, west; each runs a quarter step nearer
+    # the centre than the one before, and a corner is where two consecutive sides meet.
+    (x0, y0), (x1, y1) = lo, hi
+    pts = [(x0 + k0, y0 + k0)]
+    for i in range(4 * turns):
+        inset = k0 + step * (i + 1) / 4  # of the side that follows: where this one ends
+        x, y = pts[-1]
+        x, y = ((x1 - inset, y), (x, y1 - inset), (x0 + inset, y), (x, y0 + inset))[i % 4]
+        pts.append((x, y))
+    pts.append(tuple((lo + hi) / 2))  # the centre: the last leg runs along the long axis
     path = _dedupe(np.array(pts))
     return path if inward else path[::-1].copy()
 
 
-def lawnmower(box: Box, spacing: float, axis: int, margin: float | None = None) -> FloatArray:
-    """Back-and-forth lanes parallel to ``axis`` (0: x, "horizontal"; 1: y, "vertical"),
-    evenly spread; lanes end ``spacing / 2`` from the walls, or ``margin`` when nearer, and
+def lawnmower(box: Box, spacing: float, axis: int, margin: float | None = None,
+              min_lanes: int = 2) -> FloatArray:
+    """Back-and-forth (boustrophedon) lanes parallel to ``axis`` (0: x, "horizontal"; 1: y,
+    "vertical"), evenly spread, as many as ``spacing`` needs across the room (at least
+    ``min_lanes``); lanes end ``spacing / 2`` from the walls, or ``margin`` when nearer, and
     the outer lanes keep within ``margin`` of the side walls too."""
     lo, hi = np.array(box.lo[:2]), np.array(box.hi[:2])
     across = 1 - axis
     width = hi[across] - lo[across]
-    n = max(1, int(np.ceil(width / spacing)))
+    n = max(min_lanes, int(np.ceil(width / spacing)))
     inset = min(spacing / 2, margin if margin is not None else np.inf)
     if n == 1:
         offsets = np.array([lo[across] + width / 2])
