@@ -98,10 +98,12 @@ def test_poses_follow_the_robots_and_end_where_the_finder_saw_the_target(
     assert [where.x, where.y, where.z] == pytest.approx(detection["robot_position"], abs=1e-3)
     stamp = seen.header.stamp
     assert stamp.sec + stamp.nanosec / 1e9 == pytest.approx(t, abs=1e-6)
-    t, last = poses[-1]  # then it landed under where it was
-    assert t > detection["t"] and last.pose.position.z % 3.5 == pytest.approx(0.07, abs=1e-3)
-    assert [last.pose.position.x, last.pose.position.y] == pytest.approx(
-        detection["robot_position"][:2], abs=1e-3)
+    t, last = poses[-1]  # then it landed
+    landed = next(e for e in _events(out) if e["kind"] == "landed"
+                  and e["robot"] == detection["robot"])
+    assert t == pytest.approx(landed["t"], abs=1e-6) and t > detection["t"]
+    where = last.pose.position
+    assert [where.x, where.y, where.z] == pytest.approx(landed["position"], abs=1e-3)
     assert last.header.frame_id == "map"
     tfs = [m.transforms[0] for _, m in messages["/tf"]
            if m.transforms[0].child_frame_id == f"{detection['robot']}/base_link"]

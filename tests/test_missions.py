@@ -51,11 +51,12 @@ def test_fig7_reproduces_the_papers_assignment() -> None:
 
 
 def test_faults_mission_fails_retries_preempts_and_recovers() -> None:
-    """uav2 fails mid-spiral at 25 s; its room is retried; ugv1 is preempted at 35 s."""
+    """uav2 fails at 25 s, on its way to its room (it took off first, and ducked under the
+    lintel); its room is retried; ugv1 is preempted at 35 s."""
     result = Simulation(load_mission(Path(MISSIONS[0]).parent / "faults.yaml")).run()
     finished = [e for e in result.events if e["kind"] == "task_finished"]
     failed = [e for e in finished if e["status"] == "failed"]
-    assert [(e["t"], e["robot"], e["action"]) for e in failed] == [(25.0, "uav2", "spiral_inward")]
+    assert [(e["t"], e["robot"], e["action"]) for e in failed] == [(25.0, "uav2", "move")]
     retried = failed[0]["room"]
     later = [r for r in result.rounds if r["t"] > 25.0]
     assert any(m["room"] == retried for r in later for m in r["matching"])

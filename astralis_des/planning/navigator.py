@@ -94,7 +94,7 @@ class Navigator:
                 first = level_legs(np.vstack([at, points[1:2]]))
                 points = np.vstack([first[:-1] if len(points) > 1 else first, points[1:]])
             if self.method == "graph":
-                return Route(points)
+                return Route(self._ducked(robot, points) if robot.kind == "uav" else points)
             return self.refine(robot, points)
         finally:
             self.seconds += time.perf_counter() - t0
@@ -104,6 +104,8 @@ class Navigator:
         (a coverage path) a point no detour reaches is left out and counted, and the path
         goes on to the next one; else the route fails there."""
         radius = BODY_RADIUS[robot.kind] + self.cfg.margin
+        if robot.kind == "uav":
+            points = self._under_lintels(robot, points, radius)
         out = [points[0]]
         skipped = 0
         for b in points[1:]:
@@ -243,36 +245,83 @@ class Navigator:
 
         return valid
 
-    def _leg_free(self, robot: Robot, a: FloatArray, b: FloatArray, radius: float) -> bool:
-        """Is the straight leg clear of every box grown by ``radius``? Boxes, not the map: most
-        legs are clear, and the map is then never needed (it is built for planning only)."""
+    def _leg_free(self, robot: Robot, a: FloatArray, b: FloatArray, radius: float,
+                  furniture: bool = True) -> bool:
+        """Is the straight leg clear of every box grown by ``radius`` (walls and slabs only,
+        without ``furniture``)? Boxes, not the map: most legs are clear, and the map is then
+        never needed (it is built for planning only)."""
         a, b = a.copy(), b.copy()
         if robot.kind != "uav":  # a ground body stands on its floor: test at its middle
             a[2] = b[2] = self.world.floor_below(a) + 0.4
         keep_out = KEEP_OUT[robot.kind]
         lo, hi = np.minimum(a, b) - radius - keep_out, np.maximum(a, b) + radius + keep_out
-        furniture = self._furniture(lo, hi)
+        things = self._furniture(lo, hi) if furniture else np.zeros((0, 2, 3))
         margins = np.concatenate([np.full(len(self.world.solid_array), radius),
-                                  np.full(len(furniture), radius + keep_out)])
-        boxes = np.concatenate([self.world.solid_array, furniture])
+                                  np.full(len(things), radius + keep_out)])
+        boxes = np.concatenate([self.world.solid_array, things])
         near = np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1)
         boxes, margins = boxes[near], margins[near]
         grown = np.stack([boxes[:, 0] - margins[:, None], boxes[:, 1] + margins[:, None]], axis=1)
         return not bool(segments_hit_boxes(a[None, :], b[None, :], grown)[0])
 
-    def _duck(self, robot: Robot, a: FloatArray, b: FloatArray,
-              radius: float) -> FloatArray | None:
-        """A UAV's level leg blocked overhead (a door's lintel): the same leg flown lower,
+    def _ducked(self, robot: Robot, points: FloatArray) -> FloatArray:
+        """A UAV's route on the graph, flown under the lintels as the physics route is (the
+        other legs as they are: on the graph nothing else is planned)."""
+        radius = BODY_RADIUS[robot.kind] + self.cfg.margin
+        points = self._under_lintels(robot, points, radius)
+        free = self._solid_free(points, radius)
+        blocked = np.flatnonzero(~free(points[:-1], points[1:]))
+        if not len(blocked):
+            return points
+        out = [points[0]]
+        for i, b in enumerate(points[1:]):
+            ducked = self._duck(robot, out[-1], b, radius, furniture=False) \
+                if i in blocked else None
+            out.extend(ducked[1:] if ducked is not None else [b])
+        return np.array(out)
+
+    def _solid_free(self, points: FloatArray, radius: float):  # type: ignore[no-untyped-def]
+        """A test of many legs at once against the walls and slabs near ``points``."""
+        lo, hi = points.min(axis=0) - radius - 1.0, points.max(axis=0) + radius + 1.0
+        solids = self.world.solid_array
+        near = solids[np.all((solids[:, 0] <= hi) & (solids[:, 1] >= lo), axis=1)]
+        grown = np.stack([near[:, 0] - radius, near[:, 1] + radius], axis=1)
+
+        def free(a: FloatArray, b: FloatArray) -> np.ndarray:
+            return ~np.asarray(segments_hit_boxes(np.atleast_2d(a), np.atleast_2d(b), grown))
+
+        return free
+
+    def _under_lintels(self, robot: Robot, points: FloatArray, radius: float) -> FloatArray:
+        """A UAV's route points in a doorway too high for the lintel, brought down to the
+        highest height that is clear (not below ``DUCK_LOWEST`` over the floor)."""
+        out = np.array(points, dtype=float)
+        nudge = np.array([1e-6, 0.0, 0.0])
+        free = self._solid_free(out, radius)
+        for p in out[~free(out, out + nudge)]:
+            floor = self.world.floor_below(p - np.array([0.0, 0.0, robot.height]))
+            heights = np.arange(float(p[2]) - DUCK_STEP, floor + DUCK_LOWEST - 1e-9, -DUCK_STEP)
+            lows = np.column_stack([np.full(len(heights), p[0]), np.full(len(heights), p[1]),
+                                    heights])
+            ok = np.flatnonzero(free(lows, lows + nudge)) if len(lows) else np.zeros(0, int)
+            if len(ok):
+                out[np.all(out == p, axis=1), 2] = heights[ok[0]]
+        return out
+
+    def _duck(self, robot: Robot, a: FloatArray, b: FloatArray, radius: float,
+              furniture: bool = True) -> FloatArray | None:
+        """A UAV's leg on one storey blocked overhead (a door's lintel): the same leg lower,
         coming down before it and climbing back after, at the highest height that is clear
         (not below ``DUCK_LOWEST`` over the floor); ``None`` if none is."""
-        if abs(float(a[2] - b[2])) > 1e-6:
-            return None
-        lowest = self.world.floor_below(a - np.array([0.0, 0.0, robot.height])) + DUCK_LOWEST
-        for z in np.arange(float(a[2]) - DUCK_STEP, lowest - 1e-9, -DUCK_STEP):
+        floor = self.world.floor_below(a - np.array([0.0, 0.0, robot.height]))
+        if abs(self.world.floor_below(b - np.array([0.0, 0.0, robot.height])) - floor) > 0.5:
+            return None  # a leg between storeys (a stairwell): not a lintel's
+        top = min(float(a[2]), float(b[2]))
+        for z in np.arange(top - DUCK_STEP, floor + DUCK_LOWEST - 1e-9, -DUCK_STEP):
             a2, b2 = a.copy(), b.copy()
             a2[2] = b2[2] = z
-            if self._leg_free(robot, a2, b2, radius) and self._leg_free(robot, a, a2, radius) \
-                    and self._leg_free(robot, b2, b, radius):
+            if all(self._leg_free(robot, p, q, radius, furniture)
+                   for p, q in ((a2, b2), (a, a2), (b2, b))):
                 return np.array([a, a2, b2, b])
         return None
 
