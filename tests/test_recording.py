@@ -58,7 +58,7 @@ def test_the_recording_loads_with_its_entity_tree(faults_run: tuple[RunResult, P
     result, rrd = faults_run
     verify(rrd)
     rows = chunks(rrd)
-    for entity in ("/world/solids", "/world/rooms", "/world/target", "/mission/events",
+    for entity in ("/world/site/solids", "/world/rooms", "/world/target", "/mission/events",
                    "/mission/assignment", "/mission/metrics/rooms_searched"):
         assert entity in rows, entity
     for rid, stats in result.robots.items():
@@ -193,3 +193,41 @@ def test_ctrl_c_leaves_a_recording_and_an_event_log_that_load(tmp_path: Path) ->
     assert records[0]["kind"] == "mission_start"
     assert records[-1] == {**records[-1], "kind": "mission_end", "outcome": "interrupted"}
     assert "/robots/uav1/state" in chunks(out / "recording.rrd")
+
+
+def static_colors(rrd: Path, entity: str, component: str) -> list[int]:
+    """The packed RGBA colours of ``entity``'s static ``component`` (e.g. Points3D:colors)."""
+    out = subprocess.run([RERUN, "rrd", "print", "-vvv", str(rrd)], capture_output=True,
+                         text=True, check=True).stdout
+    for block in out.split("Chunk(")[1:]:
+        head = block.splitlines()[0]
+        if not head.endswith(f" - {entity} - ") or "with 1 rows" not in head:
+            continue
+        lines = block.splitlines()
+        header = next(line for line in lines if f"component: {component}" in line)
+        column = [c.strip() for c in header.split("┆")].index(f"component: {component}")
+        row = next(line for line in lines if "row_" in line)
+        cell = [c.strip() for c in row.split("┆")][column]
+        if cell.startswith("["):
+            return [int(v) for v in cell.strip("[]").split(",")]
+    raise AssertionError(f"no static {component} on {entity}")
+
+
+def test_storeys_are_entities_and_each_robot_has_its_colour(
+        faults_run: tuple[RunResult, Path]) -> None:
+    """Issue 24: walls and slabs by building and storey (so that the storeys above can be
+    hidden), the furniture of the rooms looked into likewise; one colour per robot, the same
+    on its pose, trail and body."""
+    result, rrd = faults_run
+    rows = chunks(rrd)
+    for storey in ("1", "2", "3", "roof"):
+        assert f"/world/A/{storey}/solids" in rows, storey
+    assert "/world/A/1/furniture" in rows and "/world/solids" not in rows
+    colors = {rid: static_colors(rrd, f"/robots/{rid}/pose", "Points3D:colors")
+              for rid in result.robots}
+    assert len({tuple(c) for c in colors.values()}) == len(result.robots)  # one each
+    for rid, color in colors.items():
+        assert static_colors(rrd, f"/robots/{rid}/trail", "LineStrips3D:colors") == color
+        assert f"/robots/{rid}/body" in rows  # its shape, moved and turned along its trail
+    assert static_colors(rrd, "/robots/uav1/body/arms", "LineStrips3D:colors") == \
+        colors["uav1"]

@@ -1,6 +1,7 @@
 """The viewer's layout, declared in code and sent with the recording: the 3-D scene and the
-task lanes on the left; the assignment graph, the camera of the robot that found the target
-(when frames were kept), the event log and the metrics on the right."""
+task lanes on the left; the assignment graph, a camera panel per robot that kept frames, the
+event log and the metrics (rooms searched, coverage and distance each on their own axis) on
+the right."""
 
 from __future__ import annotations
 
@@ -9,11 +10,14 @@ from typing import Any
 from astralis_des.sinks import paths
 
 
-def blueprint(finder: str | None, camera: bool,
-              focus: tuple[tuple[float, float, float], tuple[float, float, float]]) -> Any:
+def blueprint(finder: str | None, cameras: list[str],
+              focus: tuple[tuple[float, float, float], tuple[float, float, float]],
+              hidden: list[str] | None = None) -> Any:
     """The layout; the 3-D view looks down from the south at the box ``focus`` (the rooms
-    searched), steep enough to see into rooms over their walls. The planner's occupancy map is
-    in the recording but left out of the view (it hides the building): tick it on to see it."""
+    searched), steep enough to see into rooms over their walls, without the storeys and roofs
+    ``hidden`` (``A/3``: those above the ones searched; tick them on to see them). A camera
+    panel per robot in ``cameras`` (those that kept frames), the finder's first. The planner's
+    occupancy map is in the recording but left out of the view (it hides the building)."""
     import rerun.blueprint as rrb
 
     (x0, y0, _), (x1, y1, z1) = focus
@@ -22,19 +26,26 @@ def blueprint(finder: str | None, camera: bool,
                             look_target=(cx, cy, 0.0))
 
     right: list[Any] = [rrb.GraphView(origin=paths.MISSION_ROUNDS, name="assignment rounds")]
-    if finder is not None and camera:
-        right.append(rrb.Spatial2DView(origin=paths.robot_camera(finder),
-                                       name=f"{finder}'s camera (found the target)"))
+    ordered = sorted(cameras, key=lambda rid: rid != finder)
+    if ordered:
+        right.append(rrb.Tabs(*[rrb.Spatial2DView(
+            origin=paths.robot_camera(rid),
+            name=f"{rid}'s camera" + (" (found the target)" if rid == finder else ""))
+            for rid in ordered]))
     right += [rrb.TextLogView(origin=paths.MISSION_EVENTS, name="events"),
               rrb.Horizontal(
                   rrb.TimeSeriesView(origin=paths.MISSION_METRICS, name="search progress",
                                      contents=["+ /mission/metrics/**",
-                                               "- /mission/metrics/distance/**"]),
+                                               "- /mission/metrics/distance/**",
+                                               "- /mission/metrics/coverage/**"]),
+                  rrb.TimeSeriesView(origin=paths.mission_metric("coverage"),
+                                     name="coverage of each search (share)"),
                   rrb.TimeSeriesView(origin=paths.mission_metric("distance"),
                                      name="distance travelled (m)"))]
     scene = rrb.Spatial3DView(
         origin="/", name="mission", eye_controls=eye,
-        contents=["+ /world/**", "- /world/occupancy/**", "+ /robots/**",
+        contents=["+ /world/**", "- /world/occupancy/**",
+                  *[f"- /world/{part}/**" for part in hidden or []], "+ /robots/**",
                   "+ /mission/detections/**",
                   "- /robots/*/camera/**", "- /robots/*/imu/**", "- /robots/*/state/**",
                   "- /robots/*/task/**"])

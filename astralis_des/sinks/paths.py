@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 TIMELINE = "sim_time"
-WORLD_SOLIDS = "world/solids"
+WORLD_SOLIDS = "world/site/solids"  # outdoors; a building's are under world/<b>/<storey>/
 WORLD_ROOMS = "world/rooms"
 WORLD_TARGET = "world/target"
 WORLD_FURNITURE = "world/furniture"
@@ -15,6 +15,17 @@ WORLD_MESH = "world/mesh"  # an imported mesh
 WORLD_CLOUD = "world/cloud"  # an imported cloud, downsampled
 MISSION_EVENTS = "mission/events"
 MISSION_ROUNDS = "mission/assignment"
+
+
+def world_part(place: str, what: str) -> str:
+    """``world/A/2/solids``: what belongs to storey 2 of building A (``roof``: above the top
+    storey; ``site``: outdoors), so that the storeys above the robots can be hidden."""
+    return f"world/{place}/{what}"
+
+
+def robot_body(robot_id: str) -> str:
+    """The robot's shape, turned to its heading, moved along its trail."""
+    return f"robots/{robot_id}/body"
 
 
 def robot(robot_id: str) -> str:

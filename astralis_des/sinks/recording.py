@@ -12,6 +12,7 @@ import numpy as np
 from astralis_des.kernel.events import LEVELS, Record
 from astralis_des.sinks import paths
 from astralis_des.sinks.blueprint import blueprint
+from astralis_des.sinks.looks import TABLE_II_COLORS, by_place, log_body, robot_colors
 from astralis_des.sinks.replay import log_lanes, log_metrics, log_rounds, metrics, task_lanes
 from astralis_des.sinks.sensor_log import log_detections, log_sensors
 from astralis_des.world.clutter import Placed
@@ -26,7 +27,6 @@ OBSTACLE_COLOR = (60, 140, 60, 255)
 FURNITURE_COLORS = {"chair": (139, 90, 43, 255), "cabinet": (110, 110, 90, 255),
                     "table": (181, 136, 99, 255), "potted_plant": (34, 139, 34, 255),
                     "computer_desk": (90, 90, 130, 255), "avatar": (250, 200, 60, 255)}
-ROBOT_COLORS = {"uav": (30, 144, 255, 255), "ugv": (255, 165, 0, 255), "human": (220, 20, 60, 255)}
 
 
 class _TextColumn:
@@ -123,7 +123,7 @@ class RerunRecorder:
 
     def close(self, result: RunResult) -> None:
         rr, rec = self.rr, self.rec
-        log_furniture(rr, rec, self.sim.scene.furnished())
+        log_furniture(rr, rec, self.sim.scene.furnished(), self.sim.world)
         navigator = self.sim.navigator
         if navigator.map_built:  # the planner's occupancy map, when this run used it
             points = navigator.occupied_points()
@@ -138,9 +138,11 @@ class RerunRecorder:
             log_sensors(rr, rec, perception)
         log_detections(rr, rec, self.sim.log.records)
         self._send_new()
+        palette = robot_colors(list(self.sim.robots))
         for rid, robot in self.sim.robots.items():
             pts = np.array(robot.trail_p, dtype=float)
-            color = ROBOT_COLORS[robot.kind]
+            color = palette[rid]
+            log_body(rr, rec, robot, color)
             rec.log(paths.robot_pose(rid), rr.Points3D.from_fields(
                 radii=0.35, colors=[color], labels=[rid]), static=True)
             rec.log(paths.robot_trail(rid), rr.LineStrips3D([pts], colors=[color], radii=0.05),
@@ -185,14 +187,34 @@ class RerunRecorder:
         log_rounds(rr, rec, sim.rounds, kinds)
         cfg = sim.mission.spec.assignment
         log_metrics(rr, rec, metrics(records, sim.rounds, kinds, cfg.high_risk,
-                                     cfg.high_messiness))
-        framed = perception is not None and any(
-            f.robot == result.found_by for f in perception.frames)
-        rooms = [sim.world.rooms[r].box for r in sim.mission.searched_rooms()]
+                                     cfg.high_messiness), robot_colors(list(sim.robots)))
+        framed = {f.robot for f in perception.frames} if perception is not None else set()
+        cameras = [rid for rid in sim.robots if rid in framed]
+        searched = [sim.world.rooms[r] for r in sim.mission.searched_rooms()]
+        rooms = [r.box for r in searched]
         focus = ((min(b.lo[0] for b in rooms), min(b.lo[1] for b in rooms), 0.0),
                  (max(b.hi[0] for b in rooms), max(b.hi[1] for b in rooms),
                   max(b.hi[2] for b in rooms)))
-        rec.send_blueprint(blueprint(result.found_by, framed, focus))
+        shown = [sim.world.rooms[result.target["room"]]] if result.found_by else \
+            [min(searched, key=lambda r: r.floor)]  # up to where it was found, or began
+        rec.send_blueprint(blueprint(result.found_by, cameras, focus,
+                                     above(sim.world, shown)))
+
+
+def above(world: World, shown: Sequence[Any]) -> list[str]:
+    """The storeys (and roofs) above the highest storey of the ``shown`` rooms in each
+    building (all of a building with none): the 3-D view leaves them out, so that it looks
+    into the storey where the target was found (or where the search began)."""
+    top: dict[str, int] = {}
+    for room in shown:
+        if room.building in world.buildings:
+            top[room.building] = max(top.get(room.building, 0), room.floor)
+    hidden = []
+    for bid, building in world.buildings.items():
+        highest = top.get(bid, building.floors)
+        hidden += [f"{bid}/{n}" for n in range(highest + 1, building.floors + 1)]
+        hidden.append(f"{bid}/roof")
+    return hidden
 
 
 def describe(record: Record) -> str:
@@ -214,11 +236,14 @@ def log_solids(rr: Any, rec: Any, world: World) -> None:
     from astralis_des.sinks.imported import log_imported
 
     solids = [s for s in world.solids if s.kind != BLOCK]
-    lo = np.array([s.box.lo for s in solids]).reshape(-1, 3)
-    hi = np.array([s.box.hi for s in solids]).reshape(-1, 3)
-    colors = [SOLID_COLORS.get(s.kind, OBSTACLE_COLOR) for s in solids]
-    rec.log(paths.WORLD_SOLIDS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
-                                           colors=colors, fill_mode="solid"), static=True)
+    for place, idx in by_place(world, [s.box for s in solids]).items():
+        mine = [solids[i] for i in idx]
+        lo = np.array([s.box.lo for s in mine]).reshape(-1, 3)
+        hi = np.array([s.box.hi for s in mine]).reshape(-1, 3)
+        colors = [SOLID_COLORS.get(s.kind, OBSTACLE_COLOR) for s in mine]
+        rec.log(paths.world_part(place, "solids"), rr.Boxes3D(
+            centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2, colors=colors, fill_mode="solid"),
+            static=True)
     if world.surfaces:
         lo = np.array([s.box.lo for s in world.surfaces])
         hi = np.array([s.box.hi for s in world.surfaces])
@@ -240,15 +265,19 @@ def log_rooms(rr: Any, rec: Any, world: World, states: Mapping[str, Any]) -> Non
                                           colors=colors, labels=labels, show_labels=False))
 
 
-def log_furniture(rr: Any, rec: Any, placed: Sequence[Placed]) -> None:
-    """Furniture and avatars, once (static), coloured by kind."""
-    if not placed:
-        return
-    lo = np.array([p.box.lo for p in placed])
-    hi = np.array([p.box.hi for p in placed])
-    colors = [FURNITURE_COLORS.get(p.kind, (150, 150, 150, 255)) for p in placed]
-    labels = [p.kind if p.kind != "avatar" else
-              "avatar " + " ".join(str(v) for _, v in p.attributes) for p in placed]
-    rec.log(paths.WORLD_FURNITURE, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
-                                              colors=colors, labels=labels, show_labels=False,
-                                              fill_mode="solid"), static=True)
+def log_furniture(rr: Any, rec: Any, placed: Sequence[Placed], world: World) -> None:
+    """Furniture and avatars, once (static), by building and storey, coloured by kind (an
+    avatar in its Table II colour)."""
+    for place, idx in by_place(world, [p.box for p in placed]).items():
+        mine = [placed[i] for i in idx]
+        lo = np.array([p.box.lo for p in mine])
+        hi = np.array([p.box.hi for p in mine])
+        colors = [TABLE_II_COLORS.get(str(dict(p.attributes).get("color")), FURNITURE_COLORS[
+            "avatar"]) if p.kind == "avatar" else FURNITURE_COLORS.get(p.kind, (150, 150, 150,
+                                                                              255))
+                  for p in mine]
+        labels = [p.kind if p.kind != "avatar" else
+                  "avatar " + " ".join(str(v) for _, v in p.attributes) for p in mine]
+        rec.log(paths.world_part(place, "furniture"), rr.Boxes3D(
+            centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2, colors=colors, labels=labels,
+            show_labels=False, fill_mode="solid"), static=True)

@@ -156,10 +156,15 @@ def metrics(records: Sequence[Record], rounds: Sequence[Mapping[str, Any]],
     return series
 
 
-def log_metrics(rr: Any, rec: Any, series: Series) -> None:
+def log_metrics(rr: Any, rec: Any, series: Series,
+                colors: dict[str, tuple[int, int, int, int]] | None = None) -> None:
+    """Each series on the timeline; a robot's distance in its colour (``colors``)."""
     for name, (times, values) in series.items():
         entity = paths.mission_metric(name)
         rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE, duration=times)],
                          columns=rr.Scalars.columns(scalars=values))
         style = rr.SeriesPoints if name == "coverage" else rr.SeriesLines
-        rec.log(entity, style(names=[name.replace("_", " ")]), static=True)
+        robot = name.split("/", 1)[1] if name.startswith("distance/") else None
+        color = (colors or {}).get(robot or "")
+        rec.log(entity, style(names=[name.replace("_", " ")], colors=[color])
+                if color is not None else style(names=[name.replace("_", " ")]), static=True)

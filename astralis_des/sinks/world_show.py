@@ -49,7 +49,7 @@ def show_world(world_file: str | Path, messiness: Sequence[float], out: str | Pa
     rec.save(partial, default_blueprint=_overview(world))
     log_solids(rr, rec, world)
     log_rooms(rr, rec, world, {rid: RoomState(0.0, values[rid], "minimal") for rid in ids})
-    log_furniture(rr, rec, placed)
+    log_furniture(rr, rec, placed, world)
     rec.flush()
     rec.disconnect()
     os.replace(partial, out)

@@ -1,0 +1,114 @@
+"""How a recording draws things: where in the world each box belongs (building and storey),
+one colour per robot, robots as shapes turned to their heading, avatars in their Table II
+colour."""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from astralis_des.kernel.robot import Robot
+from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.sinks import paths
+from astralis_des.world.geometry import Box
+from astralis_des.world.model import World
+
+# One colour per robot, in team order (Okabe-Ito's colour-blind-safe set, then more).
+ROBOT_PALETTE: tuple[tuple[int, int, int, int], ...] = (
+    (0, 114, 178, 255), (230, 159, 0, 255), (0, 158, 115, 255), (204, 121, 167, 255),
+    (86, 180, 233, 255), (213, 94, 0, 255), (240, 228, 66, 255), (120, 80, 200, 255),
+    (140, 140, 140, 255), (60, 60, 60, 255))
+TABLE_II_COLORS = {"yellow": (240, 200, 40, 255), "red": (215, 40, 40, 255),
+                   "purple": (140, 60, 170, 255), "blue": (40, 90, 215, 255)}
+UAV_ARMS = 6
+UAV_ARM = 0.3  # m, centre to rotor tip (the hexacopter's collision radius)
+HUMAN_HALF = (0.25, 0.2, 0.85)  # m: a walking person's box, half sizes
+
+
+def robot_colors(robots: Sequence[str]) -> dict[str, tuple[int, int, int, int]]:
+    """Each robot's colour, used in every panel (pose, trail, plan, body, distance series)."""
+    return {rid: ROBOT_PALETTE[i % len(ROBOT_PALETTE)] for i, rid in enumerate(robots)}
+
+
+def place_of(world: World, box: Box) -> str:
+    """``A/2`` for a box of storey 2 of building A (its floor slab included), ``A/roof`` for
+    the slab over the top storey, ``site`` for one outdoors."""
+    centre = [(lo + hi) / 2 for lo, hi in zip(box.lo, box.hi, strict=True)]
+    for bid, b in world.buildings.items():
+        lo, hi = b.footprint.lo, b.footprint.hi
+        if lo[0] - 0.5 <= centre[0] <= hi[0] + 0.5 and lo[1] - 0.5 <= centre[1] <= hi[1] + 0.5:
+            storey = int(math.floor((centre[2] + 0.3) / b.floor_height)) + 1
+            return f"{bid}/roof" if storey > b.floors else f"{bid}/{max(storey, 1)}"
+    return "site"
+
+
+def by_place(world: World, boxes: Sequence[Box]) -> dict[str, list[int]]:
+    """Indices of ``boxes`` grouped by :func:`place_of`, in a stable order."""
+    groups: dict[str, list[int]] = defaultdict(list)
+    for i, box in enumerate(boxes):
+        groups[place_of(world, box)].append(i)
+    return dict(sorted(groups.items()))
+
+
+def headings(points: np.ndarray, start: float) -> np.ndarray:
+    """The heading at each trail point: the direction of the leg it ends (the heading before
+    for a point that did not move in the plane)."""
+    out = np.empty(len(points))
+    heading = start
+    for i in range(len(points)):
+        if i:
+            dx, dy = points[i, :2] - points[i - 1, :2]
+            if math.hypot(dx, dy) > 1e-6:
+                heading = math.atan2(dy, dx)
+        out[i] = heading
+    return out
+
+
+def log_body(rr: Any, rec: Any, robot: Robot, color: tuple[int, int, int, int]) -> None:
+    """The robot's shape at ``robots/<id>/body``: a hexacopter's arms and rotors, the
+    Husky's box, a person's box; moved along its trail and turned to its heading."""
+    entity = paths.robot_body(robot.id)
+    pts = np.array(robot.trail_p, dtype=float)
+    if not len(pts):
+        return
+    yaw = headings(pts, robot.heading)
+    quats = np.column_stack([np.zeros(len(yaw)), np.zeros(len(yaw)), np.sin(yaw / 2),
+                             np.cos(yaw / 2)])
+    rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE, duration=np.array(
+        robot.trail_t, dtype=float))], columns=rr.Transform3D.columns(translation=pts,
+                                                                       quaternion=quats))
+    SHAPES[robot.kind](rr, rec, entity, color)
+
+
+def _uav(rr: Any, rec: Any, entity: str, color: tuple[int, int, int, int]) -> None:
+    angles = np.arange(UAV_ARMS) * (2 * math.pi / UAV_ARMS) + math.pi / UAV_ARMS
+    tips = np.column_stack([UAV_ARM * np.cos(angles), UAV_ARM * np.sin(angles),
+                            np.zeros(UAV_ARMS)])
+    arms = [np.array([[0.0, 0.0, 0.0], tip]) for tip in tips]
+    nose = [np.array([[0.0, 0.0, 0.0], [UAV_ARM * 1.3, 0.0, 0.0]])]  # its heading
+    rec.log(entity + "/arms", rr.LineStrips3D(arms + nose, colors=[color], radii=0.025),
+            static=True)
+    rec.log(entity + "/rotors", rr.Points3D(tips, colors=[color], radii=0.08), static=True)
+
+
+def _ugv(rr: Any, rec: Any, entity: str, color: tuple[int, int, int, int]) -> None:
+    length, width = KIND_DEFAULTS["ugv"].footprint or (1.0, 0.7)
+    rec.log(entity + "/hull", rr.Boxes3D(half_sizes=[(length / 2, width / 2, 0.2)],
+                                         centers=[(0.0, 0.0, -0.2)], colors=[color],
+                                         fill_mode="solid"), static=True)
+    rec.log(entity + "/front", rr.Arrows3D(origins=[(0.0, 0.0, 0.05)],
+                                           vectors=[(length / 2 + 0.3, 0.0, 0.0)],
+                                           colors=[(255, 255, 255, 255)]), static=True)
+
+
+def _human(rr: Any, rec: Any, entity: str, color: tuple[int, int, int, int]) -> None:
+    rec.log(entity + "/person", rr.Boxes3D(half_sizes=[HUMAN_HALF], centers=[
+        (0.0, 0.0, HUMAN_HALF[2] - KIND_DEFAULTS["human"].height)], colors=[color],
+        fill_mode="solid"), static=True)
+
+
+SHAPES = {"uav": _uav, "ugv": _ugv, "human": _human}
