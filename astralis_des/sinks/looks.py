@@ -41,7 +41,7 @@ def place_of(world: World, box: Box) -> str:
     for bid, b in world.buildings.items():
         lo, hi = b.footprint.lo, b.footprint.hi
         if lo[0] - 0.5 <= centre[0] <= hi[0] + 0.5 and lo[1] - 0.5 <= centre[1] <= hi[1] + 0.5:
-            storey = int(math.floor((centre[2] + 0.3) / b.floor_height)) + 1
+            storey = math.floor((centre[2] + 0.3) / b.floor_height) + 1
             return f"{bid}/roof" if storey > b.floors else f"{bid}/{max(storey, 1)}"
     return "site"
 
