@@ -75,7 +75,8 @@ def add_api_parsers(sub: Any, add_mission_options: Callable[[Any], None]) -> Non
     chat.add_argument("mission", nargs="?", help="serve this mission file here and talk to "
                       "it (default: connect to a server)")
     chat.add_argument("--connect", metavar="ADDR", default="tcp://127.0.0.1:5555",
-                      help="the server (default tcp://127.0.0.1:5555)")
+                      help="the server (default tcp://127.0.0.1:5555); with a MISSION, the "
+                      "address to serve it on (if taken, a free port, shown)")
     chat.add_argument("--curve-keys", metavar="DIR", help="the client keys for a CURVE server")
     chat.add_argument("--timeout", type=float, default=5.0, help="s to wait for a reply")
     _add_clock_options(chat)

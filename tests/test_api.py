@@ -378,3 +378,29 @@ def test_a_request_keeps_its_own_id(client: Client) -> None:
         client.request("avatar", id="a1")
     assert caught.value.code == "bad_args" and time.monotonic() - started < 1.0
     assert client.avatar()["found"] is False  # the client still works
+
+
+def test_every_bystander_is_queryable_by_its_id(client: Client) -> None:
+    """Issue 24: only the target avatar could be queried. Once a room is furnished (the team
+    looked into it), ``avatars`` lists its bystanders and ``avatar`` with an id gives one's
+    Table II attributes, room and where it is; a walker's location moves with the clock."""
+    assert client.avatars("A.1.1.2") == {"avatars": []}  # not looked into yet
+    client.enqueue("uav1", "spiral_inward", "A.1.1.2")
+    client.step(by=5.0)
+    listed = client.avatars("A.1.1.2")["avatars"]
+    assert listed and all(a["id"].startswith("A.1.1.2/avatar-") for a in listed)
+    assert [a["id"] for a in client.avatars()["avatars"] if a["room"] == "A.1.1.2"] == [
+        a["id"] for a in listed]
+    for entry in listed:
+        one = client.avatar(entry["id"])
+        assert one["room"] == "A.1.1.2" and one["target"] is False
+        assert {k: one[k] for k in ("activity", "color", "gender", "height", "tiedToChair")} \
+            == {k: entry[k] for k in ("activity", "color", "gender", "height", "tiedToChair")}
+        assert len(one["location"]) == 3
+        if one["activity"] == "patrolling":
+            client.step(by=3.0)
+            assert client.avatar(entry["id"])["location"] != one["location"]
+    with pytest.raises(ApiError, match=r"no avatar 'A\.1\.1\.2/avatar-99'") as err:
+        client.avatar("A.1.1.2/avatar-99")
+    assert err.value.code == "unknown_avatar"
+    assert client.avatar()["found"] is False  # without an id: the target, as before

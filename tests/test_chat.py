@@ -4,6 +4,7 @@ server on loopback, and ``astralis chat`` on a pseudo-terminal."""
 from __future__ import annotations
 
 import importlib.util
+import re
 import socket
 import subprocess
 import time
@@ -385,6 +386,9 @@ def test_the_chat_serves_a_mission_file_itself(tmp_path: Path) -> None:
     assert "t = 10.0 s" in proc.stdout
     assert f"mission ended at t = 10.0 s (interrupted); outputs: {out}/" in \
         proc.stdout.replace("\n", "")
+    address = re.search(r"serving urban_search here at (tcp://127\.0\.0\.1:\d+)",
+                        proc.stdout.replace("\n", " ")).group(1)  # type: ignore[union-attr]
+    assert f"astralis teleop op1 --connect {address}" in proc.stdout.replace("\n", " ")
     assert (out / "events.jsonl").exists() and (out / "summary.json").exists()
 
 
@@ -429,3 +433,23 @@ def test_the_queue_is_right_just_after_a_preempt(chat: Chat, client: Client) -> 
     assert client.robot("uav2")["task"] == 2
     chat.text("step 2")
     assert chat.text("queue uav2") == "uav2: running task 2: hover duration=5, nothing queued"
+
+
+def test_a_chat_serving_a_mission_is_where_teleop_looks(tmp_path: Path) -> None:
+    """Issue 24: ``astralis chat MISSION`` served on a random port, so ``astralis teleop op1``
+    could not find it. It serves on teleop's default address when that is free: a client
+    with the defaults reaches it while the chat runs."""
+    proc = subprocess.Popen(cli("chat", "missions/urban_search.yaml", "--stepped",
+                                "--no-recording", "--out", str(tmp_path / "out")),
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                            env=quiet_env(tmp_path), cwd=Path(__file__).resolve().parents[1])
+    try:
+        assert proc.stdout is not None
+        banner = proc.stdout.readline() + proc.stdout.readline()
+        assert "at tcp://127.0.0.1:5555" in banner
+        assert "astralis teleop op1 --connect tcp://127.0.0.1:5555" in banner
+        with Client("tcp://127.0.0.1:5555", timeout=10.0) as client:  # teleop's default
+            assert client.robot("op1")["type"] == "human"
+    finally:
+        proc.communicate("quit\n", timeout=60)
+    assert proc.returncode == 0

@@ -92,8 +92,15 @@ class Client:
     def status(self, robot: str | None = None) -> dict[str, Any]:
         return self.request("status", **_given(robot=robot))
 
-    def avatar(self) -> dict[str, Any]:
-        return self.request("avatar")
+    def avatar(self, avatar: str | None = None) -> dict[str, Any]:
+        """The target's Table II attributes, or a bystander's by its id (``avatars``)."""
+        return self.request("avatar", avatar=avatar) if avatar is not None else \
+            self.request("avatar")
+
+    def avatars(self, room: str | None = None) -> dict[str, Any]:
+        """The bystanders of the rooms furnished so far (or of ``room``)."""
+        return self.request("avatars", room=room) if room is not None else \
+            self.request("avatars")
 
     def location(self, room: str) -> dict[str, Any]:
         return self.request("location", room=room)

@@ -11,7 +11,8 @@ from pydantic import Field
 
 from astralis_des.actions import actions_for
 from astralis_des.api.ops import OPS, Args, op
-from astralis_des.api.protocol import MAX_MESSAGE, PROTOCOL
+from astralis_des.api.protocol import MAX_MESSAGE, PROTOCOL, ApiError
+from astralis_des.errors import suggest
 from astralis_des.kernel.robot import Motion
 from astralis_des.version import __version__
 
@@ -87,9 +88,56 @@ def _status(svc: Session, args: OptionalRobot) -> dict[str, Any]:
     }
 
 
-@op("avatar")
-def _avatar(svc: Session, args: Args) -> dict[str, Any]:
-    """The target avatar's attributes (Table II); its location once it has been found."""
+class AvatarArgs(Args):
+    avatar: str | None = Field(None, description="a bystander's id, e.g. A.1.1.2/avatar-0 "
+                               "(from 'avatars'); none: the target")
+
+
+class AvatarsArgs(Args):
+    room: str | None = Field(None, description="only this room's")
+
+
+def bystanders(svc: Session, rooms: list[str]) -> dict[str, Any]:
+    """``ROOM/avatar-N`` -> the placed avatar, for the rooms already furnished (a room is
+    furnished when the team first looks into it, in kinematic fidelity; all at the start in
+    physics): querying never furnishes one, which would change the mission."""
+    scene = svc.sim.scene
+    furnished = {p.room for p in scene.furnished()}
+    out: dict[str, Any] = {}
+    for rid in rooms:
+        if rid in furnished:
+            mine = [p for p in scene.clutter(rid).placed if p.kind == "avatar"]
+            out.update({f"{rid}/avatar-{i}": p for i, p in enumerate(mine)})
+    return out
+
+
+def _bystander(svc: Session, ident: str, placed: Any) -> dict[str, Any]:
+    out: dict[str, Any] = {"id": ident, "room": placed.room, "target": False}
+    out.update({TABLE_II_AVATAR[k]: v for k, v in placed.attributes})
+    out["location"] = [round(float(v), 3) for v in placed.center]
+    movers = {m.id: m for m in svc.sim.scene.avatar_movers([placed.room])}
+    walking = [p for p in svc.sim.scene.clutter(placed.room).placed if p.kind == "avatar"
+               and dict(p.attributes).get("activity") == "patrolling"]
+    if placed in walking:  # where it is on its loop now
+        mover = movers.get(f"avatar:{placed.room}:{walking.index(placed)}")
+        if mover is not None:
+            out["location"] = [round(float(v), 3) for v in mover.positions_at(
+                np.array([svc.now]))[0]]
+    return out
+
+
+@op("avatar", AvatarArgs)
+def _avatar(svc: Session, args: AvatarArgs) -> dict[str, Any]:
+    """An avatar's attributes (Table II): the target's (its location once it has been found),
+    or with ``avatar`` (an id) a bystander's, with its room and where it is."""
+    if args.avatar is not None:
+        room = args.avatar.split("/", 1)[0]
+        known = bystanders(svc, [svc.room(room).id])
+        if args.avatar not in known:
+            hint = suggest(args.avatar, known) if known else f"none in {room} yet"
+            raise ApiError("unknown_avatar", f"no avatar '{args.avatar}'; {hint} (the "
+                           "avatars query lists them)")
+        return _bystander(svc, args.avatar, known[args.avatar])
     target = svc.sim.target
     out: dict[str, Any] = {TABLE_II_AVATAR[k]: v for k, v in target.avatar.items()}
     out["found"] = svc.sim.found.triggered
@@ -97,6 +145,17 @@ def _avatar(svc: Session, args: Args) -> dict[str, Any]:
         out["location"] = list(target.position)
         out["room"] = target.room
     return out
+
+
+@op("avatars", AvatarsArgs)
+def _avatars(svc: Session, args: AvatarsArgs) -> dict[str, Any]:
+    """The bystanders of the rooms furnished so far (or of ``room``): id, room, Table II
+    attributes; the target is not among them."""
+    rooms = [svc.room(args.room).id] if args.room is not None else sorted(svc.sim.world.rooms)
+    found = bystanders(svc, rooms)
+    return {"avatars": [{"id": ident, "room": p.room,
+                         **{TABLE_II_AVATAR[k]: v for k, v in p.attributes}}
+                        for ident, p in found.items()]}
 
 
 @op("location", RoomArgs)

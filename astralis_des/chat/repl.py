@@ -228,8 +228,18 @@ def _serve_here(args: argparse.Namespace, console: Console) -> tuple[Any, Path, 
     from astralis_des.mission.overrides import mission_from_args
 
     mission, out = mission_from_args(args)
-    background = Background(mission, pace=args.pace, running=not args.stepped, out_dir=out)
-    address = background.start()
+    try:  # the address teleop and other clients look at by default, if it is free
+        background = Background(mission, bind=args.connect, pace=args.pace,
+                                running=not args.stepped, out_dir=out)
+        address = background.start()
+    except Exception:  # taken (another server): any free port, shown below
+        background = Background(mission, pace=args.pace, running=not args.stepped,
+                                out_dir=out)
+        address = background.start()
     clock = "paused: step moves time" if args.stepped else f"running at {args.pace:g}x"
-    console.print(Text(f"serving {mission.name} here (clock {clock}); outputs go to {out}/"))
+    console.print(Text(f"serving {mission.name} here at {address} (clock {clock}); outputs go "
+                       f"to {out}/"), soft_wrap=True)  # one line each: a command to copy
+    walker = next((m.id for m in mission.spec.team if m.kind == "human"), mission.spec.team[0].id)
+    console.print(Text(f"drive a robot from another terminal: astralis teleop {walker} "
+                       f"--connect {address}"), soft_wrap=True)
     return background, out, address
