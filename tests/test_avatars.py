@@ -42,3 +42,25 @@ def test_a_file_that_ties_a_patrolling_target_is_refused(urban_search: Mission) 
     with pytest.raises(InputError, match="only a sitting avatar is tied to a chair"):
         urban_search.with_changes(target={"room": "A.1.1.1", "avatar": {
             "activity": "patrolling", "tied_to_chair": True}})
+
+
+def test_sitting_bystanders_sit_on_chairs(urban_search: Mission) -> None:
+    """Issue 24: every sitting bystander is on a chair of its room (one it found free, or one
+    brought for it), one avatar a chair; over 300 furnished rooms at full messiness."""
+    world = urban_search.world
+    sitting = 0
+    for seed in range(100):
+        for room in ("A.1.1.1", "A.1.1.2", "A.2.2.3"):
+            clutter = place_room(world, room, 1.0, np.random.default_rng(seed))
+            chairs = [p for p in clutter.placed if p.kind == "chair"]
+            seated = [p for p in clutter.placed if p.kind == "avatar"
+                      and dict(p.attributes)["activity"] == "sitting"]
+            taken = []
+            for avatar in seated:
+                under = [c for c in chairs if np.allclose(c.center[:2], avatar.center[:2])]
+                assert len(under) == 1, (seed, room, avatar)
+                taken.append(id(under[0]))
+                assert avatar.box.lo[2] == pytest.approx(world.floor_below(avatar.center))
+            assert len(taken) == len(set(taken))  # one avatar a chair
+            sitting += len(seated)
+    assert sitting > 50

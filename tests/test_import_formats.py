@@ -11,6 +11,7 @@ import pytest
 from scenes import (
     BUILDING,
     FT_WKT,
+    GROUND_Z,
     SIZE,
     cloud_points,
     scene_mesh,
@@ -26,6 +27,7 @@ from astralis_des.importers import ImportOptions, formats, import_world
 from astralis_des.world.build import load_world
 from astralis_des.world.model import World
 
+ROOT = Path(__file__).resolve().parents[1]
 MARGIN = 2.0
 VOXEL = 0.5
 OPTIONS = ImportOptions(voxel=VOXEL, margin=MARGIN, area_size=10.0)
@@ -145,3 +147,61 @@ def test_every_registered_extension_is_tested() -> None:
     """The registry's formats are exactly those exercised here and in the real-data tests."""
     assert sorted(formats()) == sorted(["csv", "glb", "gltf", "las", "laz", "obj", "pcd", "ply",
                                         "stl", "txt", "xyz"])
+
+
+def test_a_classified_aerial_tile_gives_a_solid_building_and_a_canopy_to_walk_under(
+        tmp_path: Path) -> None:
+    """Issue 24: the classes of an aerial scan are used. The building (class 6, seen as a
+    roof and walls) is a solid from its roof to the ground, which a UAV's route goes round;
+    a tree's crown (class 5, points 3 to 7 m up) is kept where it is: blocked up there, free
+    under it, so a walker passes under it. Noise (class 7) is left out."""
+    points, classes = cloud_points()
+    tx, ty = 30.0, 22.0  # a tree on the open ground, file frame
+    ang, rad = np.meshgrid(np.linspace(0, 2 * np.pi, 40), np.linspace(0.0, 2.0, 8))
+    crown = [np.column_stack([tx + (rad * np.cos(ang)).ravel(), ty + (rad * np.sin(ang)).ravel(),
+                              np.full(ang.size, GROUND_Z + z)]) for z in np.arange(3.0, 7.01, 0.4)]
+    noise = np.array([[5.0, 25.0, GROUND_Z + 30.0]])
+    crown_pts = np.vstack(crown)
+    points = np.vstack([points, crown_pts, noise])
+    classes = np.concatenate([classes, np.full(len(crown_pts), 5), [7]]).astype(np.uint8)
+    world = imported(tmp_path, write_las(tmp_path / "tile.las", points, classes))
+    blocks = world.block_array
+
+    def blocked(x: float, y: float, z: float) -> bool:
+        p = np.array([x + MARGIN, y + MARGIN, z])
+        return bool(np.all((blocks[:, 0] <= p) & (blocks[:, 1] >= p), axis=1).any())
+
+    (x0, y0), (x1, y1), height = BUILDING
+    cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+    assert all(blocked(cx, cy, z) for z in (0.5, 2.5, height - 0.3))  # solid, not a shell
+    assert blocked(tx, ty, 5.0) and blocked(tx + 1.0, ty, 4.0)  # the crown
+    assert not blocked(tx, ty, 1.0) and not blocked(tx + 1.0, ty, 2.0)  # free under it
+    assert blocks[:, 1, 2].max() == pytest.approx(7.0, abs=VOXEL)  # not the 30 m noise point
+
+    from astralis_des import Simulation, load_mission
+
+    (tmp_path / "out" / "m.yaml").write_text(f"""name: classified
+world: twin.yaml
+fidelity: physics
+team:
+  - {{id: uav1, kind: uav, start: [{x0 - 4.0 + MARGIN}, {cy + MARGIN}, 0], height: 2}}
+  - {{id: op1, kind: human, start: [{tx - 4.0 + MARGIN}, {ty + MARGIN}, 0]}}
+scene: {{clutter: false}}
+assignment: {{search: [S]}}
+""")
+    sim = Simulation(load_mission(tmp_path / "out" / "m.yaml"))
+    uav = sim.robots["uav1"]
+    start = sim.world.on_floor(uav.pose)
+    goal = np.array([x1 + 4.0 + MARGIN, cy + MARGIN, 0.0])
+    route = sim.navigator.route(uav, start, goal)
+    assert route.points is not None, route.reason
+    xy = route.points[:, :2] - MARGIN
+    assert np.abs(xy[:, 1] - cy).max() > (y1 - y0) / 2  # it went round the building
+    walker = sim.robots["op1"]
+    trunk = np.array([tx + MARGIN, ty + MARGIN])
+    ring = trunk + 1.0 * np.column_stack([np.cos(np.arange(8)), np.sin(np.arange(8))])
+    at = np.column_stack([ring, np.full(8, walker.height)])
+    assert sim.navigator.fits(walker, at).all()  # a walker fits under the crown
+    high = np.column_stack([ring, np.full(8, 5.0)])
+    assert not sim.navigator.fits(uav, high).any()  # a UAV does not fit in it
+    sim.finish()

@@ -6,7 +6,11 @@ Heights are heights above the ground (a normalised height model): the physics gr
 plane, so the terrain's relief (reported) is flattened, and whatever stands on it keeps its
 height. ``fill: columns`` (aerial scans) makes each occupied column solid down to the ground,
 since an aerial scanner sees the roof and not what is under it; ``none`` keeps the voxels the
-points fall in (terrestrial and indoor scans, which see walls).
+points fall in (terrestrial and indoor scans, which see walls). A classified cloud (ASPRS
+classes) is used as classified: ground (2) is the ground, buildings (6) and unclassified points
+stand as the fill says (an aerial scan's building: a solid from its roof down), vegetation
+(3-5) is canopy kept where its points are (a UAV plans round a crown, a walker passes under
+it), noise (7, 18) is left out.
 """
 
 from __future__ import annotations
@@ -36,6 +40,8 @@ from astralis_des.world.geometry import FloatArray
 
 log = logging.getLogger(__name__)
 
+VEGETATION_CLASSES = (3, 4, 5)  # ASPRS low, medium, high vegetation: drawn where it is
+NOISE_CLASSES = (7, 18)  # ASPRS low and high noise: left out
 MIN_HEIGHT = 0.3  # m above the ground: lower points are the ground's own clutter (grass, kerbs)
 AREA_HEIGHT = 10.0  # m: an area on the ground is searched up to this height
 CLEARANCE = 1.0  # m kept between an area and the nearest block
@@ -72,9 +78,16 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions) -> Built:
     shape = grid_shape(extent, opts.voxel, what="the cloud")
     site = (shape[0] * opts.voxel, shape[1] * opts.voxel)
     standing = ~ground.mask & (height > MIN_HEIGHT)
+    canopy = np.zeros(len(standing), dtype=bool)
+    if classes is not None:  # ASPRS classes: noise left out; vegetation is canopy (below)
+        standing &= ~np.isin(classes, NOISE_CLASSES)
+        canopy = standing & np.isin(classes, VEGETATION_CLASSES)
     fill = opts.fill if opts.fill != "auto" else (
         "columns" if path.suffix.lower() in (".las", ".laz") else "none")
-    boxes, blocked = _blocks(local, height, standing, shape, opts.voxel, fill)
+    boxes, blocked = _blocks(local, height, standing & ~canopy, shape, opts.voxel, fill)
+    if canopy.any():  # only where its points are: a walker passes under a tree's crown
+        crown, under = _blocks(local, height, canopy, shape, opts.voxel, "none")
+        boxes, blocked = np.concatenate([boxes, crown]), blocked | under
     areas = _areas(local, blocked, shape, opts)
     sample = _sample(len(local), opts.cloud_points, rng)
     cloud_xyz = np.column_stack([local[sample], height[sample]]).astype(np.float32)
@@ -87,7 +100,7 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions) -> Built:
               "offset": offset, "ground": ground.method,
               "ground_share": round(ground.share, 4), "relief": round(ground.relief, 2)}
     stats = {"ground_share": ground.share, "classified_share": classified, "fill": fill,
-             "standing": int(standing.sum())}
+             "standing": int(standing.sum()), "canopy": int(canopy.sum())}
     return Built("cloud", site, opts.voxel, boxes, areas, source, "boxes",
                  floors=[0.0], cloud=cloud_xyz, cloud_colors=cloud_rgb, stats=stats)
 

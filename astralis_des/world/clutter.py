@@ -8,7 +8,7 @@ width, stays reachable from the door. Items that do not fit are reported, never 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -113,12 +113,36 @@ def place_room(world: World, room_id: str, messiness: float, rng: np.random.Gene
             put(kind, (float(size[0]), float(size[1]), float(size[2])), item.against_wall,
                 item.clearance)
     avatars = catalogue.avatars
+    free_chairs = [p for p in placed if p.kind == "chair"]
     for _ in range(_count(messiness * avatars.per_room_at_full)):
         attributes = _draw_attributes(catalogue, rng)
         values = dict(attributes)
-        put(AVATAR, avatar_size(str(values["activity"]), str(values["height"])), False,
-            avatars.clearance, attributes)
+        body = avatar_size(str(values["activity"]), str(values["height"]))
+        if values["activity"] == "sitting":
+            seat = _seat(free_chairs, catalogue, rng, put, placed)
+            if seat is not None:  # on a chair: the room's, or one brought for it
+                placed.append(Placed(AVATAR, room_id, (seat.center[0], seat.center[1],
+                                                       space.floor_z + body[2] / 2),
+                                     body, seat.yaw, attributes))
+                continue
+        put(AVATAR, body, False, avatars.clearance, attributes)
     return Clutter(tuple(placed), tuple(skipped))
+
+
+def _seat(free: list[Placed], catalogue: Catalogue, rng: np.random.Generator,
+          put: Callable[..., None], placed: list[Placed]) -> Placed | None:
+    """A chair for a sitting avatar: one of the room's free chairs at random, else a new
+    one placed for it (none if the catalogue has no chairs, or none fits)."""
+    if free:
+        return free.pop(int(rng.integers(len(free))))
+    chair = catalogue.items.present().get("chair")
+    if chair is None:
+        return None
+    before = len(placed)
+    size = rng.uniform(chair.size_min, chair.size_max)
+    put("chair", (float(size[0]), float(size[1]), float(size[2])), chair.against_wall,
+        chair.clearance)
+    return placed[-1] if len(placed) > before else None
 
 
 MEMO_ROOMS = 4096  # furnished rooms a world keeps in memory (a tune's trials reuse them)
