@@ -64,3 +64,23 @@ def test_sitting_bystanders_sit_on_chairs(urban_search: Mission) -> None:
             assert len(taken) == len(set(taken))  # one avatar a chair
             sitting += len(seated)
     assert sitting > 50
+
+
+def test_open_air_areas_get_bystanders_but_no_furniture_unless_asked() -> None:
+    """Issue 24: an imported world's search areas were furnished like offices (chairs on the
+    open ground). Out in the open only bystanders are placed, unless the mission asks for
+    furniture with scene.furnish_outdoors."""
+    from pathlib import Path
+
+    from astralis_des import load_mission
+
+    mission = load_mission(Path(__file__).resolve().parents[1] / "missions" /
+                           "autzen_recon.yaml")
+    rooms = {rid: {"messiness": 1.0} for rid in ("S.1.1.1", "S.1.1.2", "S.1.2.1", "S.1.2.2")}
+    plain = Simulation(mission.with_changes(rooms={"set": rooms}))
+    kinds = {p.kind for rid in rooms for p in plain.scene.clutter(rid).placed}
+    assert kinds == {"avatar"}
+    asked = Simulation(mission.with_changes(rooms={"set": rooms},
+                                            scene={"furnish_outdoors": True}))
+    kinds = {p.kind for rid in rooms for p in asked.scene.clutter(rid).placed}
+    assert "avatar" in kinds and kinds - {"avatar"}

@@ -325,6 +325,8 @@ class SceneSpec(Strict):
 
     clutter: bool = True
     catalogue: str | None = Field(None, description="catalogue file, relative to the mission")
+    furnish_outdoors: bool = Field(False, description="furniture in the search areas out in "
+                                   "the open too (else only their bystanders)")
     movers: int = Field(0, ge=0, le=100, description="moving obstacles in corridors")
     mover_speed: PositiveFloat = Field(0.6, le=MAX_SPEED, description="m/s")
 

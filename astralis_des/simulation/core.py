@@ -67,6 +67,7 @@ class Simulation:
         self.scene = Scene(self.world, {r: s.messiness for r, s in self.rooms.items()},
                            spec.seed, mission.clutter_catalogue(), clutter=spec.scene.clutter,
                            movers=spec.scene.movers, mover_speed=spec.scene.mover_speed,
+                           furnish_outdoors=spec.scene.furnish_outdoors,
                            on_skipped=self._not_placed)
         self.target = draw_target(mission, self.scene)
         self.sensor = GeometricSensor(self.scene, self.target,

@@ -12,6 +12,7 @@ from __future__ import annotations
 import bisect
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -88,15 +89,24 @@ class Target:
         return self.positions_at(np.array([t]))[0]
 
 
+@lru_cache(maxsize=8)
+def _people_only(catalogue: Catalogue) -> Catalogue:
+    """The catalogue without its furniture (kept: a world's furnished-room memo knows a
+    catalogue by identity)."""
+    return catalogue.model_copy(update={"items": type(catalogue.items)()})
+
+
 class Scene:
     def __init__(self, world: World, messiness: Mapping[str, float], seed: int,
                  catalogue: Catalogue, *, clutter: bool = True, movers: int = 0,
-                 mover_speed: float = 0.6,
+                 mover_speed: float = 0.6, furnish_outdoors: bool = False,
                  on_skipped: Callable[[str, str, str], None] | None = None) -> None:
         self.world = world
         self.messiness = dict(messiness)
         self.seed = seed
         self.catalogue = catalogue
+        # out in the open only bystanders, unless asked: no office chairs on a lawn
+        self.outdoors = catalogue if furnish_outdoors else _people_only(catalogue)
         self.enabled = clutter
         self.on_skipped = on_skipped  # told of each item a room had no place for
         # told of each room when it is furnished (the physics adds its bodies then)
@@ -115,8 +125,10 @@ class Scene:
             if not self.enabled:
                 self.set_clutter(room_id, Clutter((), ()))
             else:
+                indoors = self.world.rooms[room_id].building in self.world.buildings
                 placed = furnish(self.world, room_id, self.messiness.get(room_id, 0.0),
-                                 self.seed, self._order[room_id], self.catalogue)
+                                 self.seed, self._order[room_id],
+                                 self.catalogue if indoors else self.outdoors)
                 self.set_clutter(room_id, self._clear_target(room_id, placed))
                 if self.on_skipped is not None:
                     for skipped in self._rooms[room_id].skipped:
