@@ -103,10 +103,18 @@ def unreachable_wide_cells(room: Room, placed: Sequence[Placed], passage: float)
 
 
 def test_footprints_never_overlap(world: World, runs: dict[tuple[int, float], Clutter]) -> None:
-    """No two footprints overlap, nor come closer than the larger of their clearances."""
+    """No two footprints overlap, nor come closer than the larger of their clearances (but a
+    sitting avatar, who sits on a chair: issue 24)."""
     for clutter in runs.values():
+        chairs = {p.center[:2] for p in clutter.placed if p.kind == "chair"}
         for a, b in itertools.combinations(clutter.placed, 2):
-            gap = max(clearance(a.kind), clearance(b.kind))
+            if {a.kind, b.kind} == {"chair", "avatar"} and a.center[:2] == b.center[:2]:
+                continue  # the avatar on its chair
+            seated = [p for p in (a, b) if p.kind == "avatar" and p.center[:2] in chairs]
+            # a seated avatar keeps its chair's clearance, less the 5 cm its body may
+            # reach past the chair's seat on each side
+            gap = max(clearance("chair") - 0.05, 0.0) if seated else \
+                max(clearance(a.kind), clearance(b.kind))
             assert not overlap(a.box, b.box, gap), (a, b)
 
 
@@ -219,11 +227,14 @@ def tiny_world() -> World:
 
 
 def test_a_tiny_room_reports_what_does_not_fit() -> None:
-    """A 1.5 x 1.5 m room at messiness 1 lists its two bystanders as skipped, not raising."""
+    """A 1.5 x 1.5 m room at messiness 1 lists its two bystanders as skipped, not raising
+    (and the chair brought for a sitting one)."""
     world = tiny_world()
     clutter = place_room(world, "T.1.1.1", 1.0, np.random.default_rng(0))
     assert clutter.placed == ()
-    assert [(room, kind) for room, kind, _ in clutter.skipped] == [("T.1.1.1", "avatar")] * 2
+    skipped = [(room, kind) for room, kind, _ in clutter.skipped]
+    assert skipped.count(("T.1.1.1", "avatar")) == 2
+    assert set(skipped) <= {("T.1.1.1", "avatar"), ("T.1.1.1", "chair")}
     assert all(reason.startswith("no ") and "spot on the free floor" in reason
                for _, _, reason in clutter.skipped)
 
