@@ -18,6 +18,7 @@ import numpy as np
 
 from astralis_des.errors import InputError
 from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.planning.lintels import Lintels
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
 if TYPE_CHECKING:
@@ -35,8 +36,6 @@ RIM = 0.25  # m between the points a rectangular footprint is checked at, along 
 NUDGE = 0.6  # m: how far a leg's end in collision may be moved to a free point
 CELL = 0.1  # m, walkers' floor grid
 LIFT_SLACK = 0.05  # m above the clearance a UAV's point lifted over furniture is put
-DUCK_STEP = 0.05  # m: the heights a UAV tries, one below the other, to pass under a lintel
-DUCK_LOWEST = 1.0  # m over the floor: it flies no lower to pass under one
 
 
 @dataclass(frozen=True)
@@ -53,7 +52,7 @@ class Robot(Protocol):
     height: float  # m above the floor of its sensor: where its route runs
 
 
-class Navigator:
+class Navigator(Lintels):
     def __init__(self, world: World, scene: Scene, spec: MissionSpec) -> None:
         self.world, self.scene, self.cfg = world, scene, spec.planning
         method = self.cfg.method
@@ -94,7 +93,8 @@ class Navigator:
                 first = level_legs(np.vstack([at, points[1:2]]))
                 points = np.vstack([first[:-1] if len(points) > 1 else first, points[1:]])
             if self.method == "graph":
-                return Route(self._ducked(robot, points) if robot.kind == "uav" else points)
+                return Route(self._ducked(robot, points, BODY_RADIUS[robot.kind] +
+                                          self.cfg.margin) if robot.kind == "uav" else points)
             return self.refine(robot, points)
         finally:
             self.seconds += time.perf_counter() - t0
@@ -263,67 +263,6 @@ class Navigator:
         boxes, margins = boxes[near], margins[near]
         grown = np.stack([boxes[:, 0] - margins[:, None], boxes[:, 1] + margins[:, None]], axis=1)
         return not bool(segments_hit_boxes(a[None, :], b[None, :], grown)[0])
-
-    def _ducked(self, robot: Robot, points: FloatArray) -> FloatArray:
-        """A UAV's route on the graph, flown under the lintels as the physics route is (the
-        other legs as they are: on the graph nothing else is planned)."""
-        radius = BODY_RADIUS[robot.kind] + self.cfg.margin
-        points = self._under_lintels(robot, points, radius)
-        free = self._solid_free(points, radius)
-        blocked = np.flatnonzero(~free(points[:-1], points[1:]))
-        if not len(blocked):
-            return points
-        out = [points[0]]
-        for i, b in enumerate(points[1:]):
-            ducked = self._duck(robot, out[-1], b, radius, furniture=False) \
-                if i in blocked else None
-            out.extend(ducked[1:] if ducked is not None else [b])
-        return np.array(out)
-
-    def _solid_free(self, points: FloatArray, radius: float):  # type: ignore[no-untyped-def]
-        """A test of many legs at once against the walls and slabs near ``points``."""
-        lo, hi = points.min(axis=0) - radius - 1.0, points.max(axis=0) + radius + 1.0
-        solids = self.world.solid_array
-        near = solids[np.all((solids[:, 0] <= hi) & (solids[:, 1] >= lo), axis=1)]
-        grown = np.stack([near[:, 0] - radius, near[:, 1] + radius], axis=1)
-
-        def free(a: FloatArray, b: FloatArray) -> np.ndarray:
-            return ~np.asarray(segments_hit_boxes(np.atleast_2d(a), np.atleast_2d(b), grown))
-
-        return free
-
-    def _under_lintels(self, robot: Robot, points: FloatArray, radius: float) -> FloatArray:
-        """A UAV's route points in a doorway too high for the lintel, brought down to the
-        highest height that is clear (not below ``DUCK_LOWEST`` over the floor)."""
-        out = np.array(points, dtype=float)
-        nudge = np.array([1e-6, 0.0, 0.0])
-        free = self._solid_free(out, radius)
-        for p in out[~free(out, out + nudge)]:
-            floor = self.world.floor_below(p - np.array([0.0, 0.0, robot.height]))
-            heights = np.arange(float(p[2]) - DUCK_STEP, floor + DUCK_LOWEST - 1e-9, -DUCK_STEP)
-            lows = np.column_stack([np.full(len(heights), p[0]), np.full(len(heights), p[1]),
-                                    heights])
-            ok = np.flatnonzero(free(lows, lows + nudge)) if len(lows) else np.zeros(0, int)
-            if len(ok):
-                out[np.all(out == p, axis=1), 2] = heights[ok[0]]
-        return out
-
-    def _duck(self, robot: Robot, a: FloatArray, b: FloatArray, radius: float,
-              furniture: bool = True) -> FloatArray | None:
-        """A UAV's leg on one storey blocked overhead (a door's lintel): the same leg lower,
-        coming down before it and climbing back after, at the highest height that is clear
-        (not below ``DUCK_LOWEST`` over the floor); ``None`` if none is."""
-        floor = self.world.floor_below(a - np.array([0.0, 0.0, robot.height]))
-        if abs(self.world.floor_below(b - np.array([0.0, 0.0, robot.height])) - floor) > 0.5:
-            return None  # a leg between storeys (a stairwell): not a lintel's
-        top = min(float(a[2]), float(b[2]))
-        for z in np.arange(top - DUCK_STEP, floor + DUCK_LOWEST - 1e-9, -DUCK_STEP):
-            a2, b2 = a.copy(), b.copy()
-            a2[2] = b2[2] = z
-            if all(self._leg_free(robot, p, q, radius, furniture)
-                   for p, q in ((a2, b2), (a, a2), (b2, b))):
-                return np.array([a, a2, b2, b])
-        return None
 
     # -- planning a leg --------------------------------------------------------------------
     def _plan_leg(self, robot: Robot, a: FloatArray, b: FloatArray,
