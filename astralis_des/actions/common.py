@@ -21,6 +21,7 @@ DOOR_OFFSET = 0.6  # m in front of a door's wall: where robots stop by a door
 TURN_MARGIN = 0.1  # m kept between a wall and the circle a body sweeps turning on the spot
 LANDING_CLEAR = 0.45  # m: half the side of the square of floor a landing UAV needs free
 LANDING_RINGS = (0.0, 0.6, 1.2, 1.8, 2.4)  # m around a UAV where it looks for that square
+ROBOT_ROOM = 0.7  # m: half the side of the square another robot takes (the Husky turning)
 LOOK_AROUND = 2.0  # s spent looking round a room that cannot be searched by its pattern
 ActionGen = Generator[simpy.Event, Any, ActionResult]
 StepGen = Generator[simpy.Event, Any, float]
@@ -94,7 +95,17 @@ def landing_spot(ctx: Context, robot: Robot) -> FloatArray:
     here = robot.position(ctx.env.now)
     floor = ctx.world.floor_below(here)
     room = ctx.world.room_at((here[0], here[1], floor + 0.5))
-    boxes = ctx.sensor.scene.blockers([room.id] if room is not None else [])
+    scene = ctx.sensor.scene
+    boxes = scene.blockers([room.id] if room is not None else [])
+    walks = [*scene.movers, *scene.avatar_movers([room.id] if room is not None else [])]
+    if walks:  # nor on the loop a walker or an obstacle goes round
+        boxes = np.concatenate([boxes, *[_along(m.loop, m.size) for m in walks]])
+    others = [r.position(ctx.env.now) for r in ctx.robots.values() if r is not robot]
+    if others:  # nor on another robot (a UGV under it in a corridor)
+        at = np.array(others)
+        lo = np.column_stack([at[:, :2] - ROBOT_ROOM, np.full(len(at), -1e3)])
+        hi = np.column_stack([at[:, :2] + ROBOT_ROOM, at[:, 2] + 0.5])
+        boxes = np.concatenate([boxes, np.stack([lo, hi], axis=1)])
     for reach in LANDING_RINGS:
         angles = np.linspace(0.0, 2 * np.pi, 1 if reach == 0 else 12, endpoint=False)
         for angle in angles:
@@ -106,6 +117,16 @@ def landing_spot(ctx: Context, robot: Robot) -> FloatArray:
             if reach == 0 or bool(ctx.sensor.scene.line_of_sight(here, spot)[0]):
                 return spot
     return here
+
+
+def _along(loop: FloatArray, size: tuple[float, float, float]) -> FloatArray:
+    """``(K, 2, 3)`` boxes of a body of ``size`` every 0.2 m along its ``loop``."""
+    legs = np.diff(loop, axis=0)
+    steps = np.maximum(np.ceil(np.linalg.norm(legs, axis=1) / 0.2).astype(int), 1)
+    pts = np.vstack([a + np.outer(np.arange(n) / n, leg)
+                     for a, leg, n in zip(loop[:-1], legs, steps, strict=True)])
+    half = np.asarray(size) / 2
+    return np.stack([pts - half, pts + half], axis=1)
 
 
 def land(ctx: Context, robot: Robot) -> StepGen:
