@@ -4,6 +4,7 @@ back after it (in both fidelities, the same way)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
@@ -30,10 +31,8 @@ class Lintels:
 
     world: World
     cfg: Any
-
-    def _leg_free(self, robot: Robot, a: FloatArray, b: FloatArray, radius: float,
-                  furniture: bool = True) -> bool:
-        raise NotImplementedError
+    _leg_free: Callable[..., bool]  # the navigator's: is a straight leg clear (robot, a, b,
+    # radius, furniture)?
 
     def _ducked(self, robot: Robot, points: FloatArray, radius: float) -> FloatArray:
         """A UAV's route on the graph, flown under the lintels as the physics route is (the
