@@ -31,6 +31,11 @@ class KindDefaults:
     # or drives (its sensor is always at ``height``)
 
     @property
+    def flies(self) -> bool:
+        """Whether it takes off and lands (a UAV): it has a resting height."""
+        return self.rest is not None
+
+    @property
     def swept_radius(self) -> float | None:
         """The circle a body with a footprint sweeps turning on the spot (its half-diagonal)."""
         if self.footprint is None:

@@ -114,7 +114,7 @@ def landing_spot(ctx: Context, robot: Robot) -> FloatArray:
             hi = np.array([spot[0] + LANDING_CLEAR, spot[1] + LANDING_CLEAR, here[2]])
             if np.any(np.all((boxes[:, 0] < hi) & (boxes[:, 1] > lo), axis=1)):
                 continue
-            if reach == 0 or bool(ctx.sensor.scene.line_of_sight(here, spot)[0]):
+            if reach == 0 or bool(scene.line_of_sight(here, spot)[0]):
                 return spot
     return here
 

@@ -115,14 +115,12 @@ def _bystander(svc: Session, ident: str, placed: Any) -> dict[str, Any]:
     out: dict[str, Any] = {"id": ident, "room": placed.room, "target": False}
     out.update({TABLE_II_AVATAR[k]: v for k, v in placed.attributes})
     out["location"] = [round(float(v), 3) for v in placed.center]
-    movers = {m.id: m for m in svc.sim.scene.avatar_movers([placed.room])}
-    walking = [p for p in svc.sim.scene.clutter(placed.room).placed if p.kind == "avatar"
-               and dict(p.attributes).get("activity") == "patrolling"]
+    scene = svc.sim.scene
+    walking = scene.patrolling(placed.room)
     if placed in walking:  # where it is on its loop now
-        mover = movers.get(f"avatar:{placed.room}:{walking.index(placed)}")
-        if mover is not None:
-            out["location"] = [round(float(v), 3) for v in mover.positions_at(
-                np.array([svc.now]))[0]]
+        mover = scene.avatar_movers([placed.room])[walking.index(placed)]
+        out["location"] = [round(float(v), 3) for v in mover.positions_at(
+            np.array([svc.now]))[0]]
     return out
 
 

@@ -26,13 +26,10 @@ DUCK_LOWEST = 1.0  # m over the floor: it flies no lower to pass under one
 
 
 class Lintels:
-    """The navigator's lintel rules (a mixin: it needs ``world``, ``cfg`` and
-    ``_leg_free``)."""
+    """The navigator's lintel rules (a mixin: it needs ``world`` and ``_furniture``)."""
 
     world: World
-    cfg: Any
-    _leg_free: Callable[..., bool]  # the navigator's: is a straight leg clear (robot, a, b,
-    # radius, furniture)?
+    _furniture: Callable[[FloatArray, FloatArray], FloatArray]  # still boxes near [lo, hi]
 
     def _ducked(self, robot: Robot, points: FloatArray, radius: float) -> FloatArray:
         """A UAV's route on the graph, flown under the lintels as the physics route is (the
@@ -42,23 +39,68 @@ class Lintels:
         if key in memo:
             return np.array(memo[key])
         points = self._under_lintels(robot, points, radius)
-        free = self._solid_free(points, radius)
+        free = self._free(points, radius)
         blocked = set(np.flatnonzero(~free(points[:-1], points[1:])).tolist())
         out = [points[0]]
         for i, b in enumerate(points[1:]):
-            ducked = self._duck_walls(robot, out[-1], b, free) if i in blocked else None
+            ducked = self._duck(robot, out[-1], b, free) if i in blocked else None
             out.extend(ducked[1:] if ducked is not None else [b])
         memo[key] = np.array(out)
         return np.array(out)
 
-    def _duck_walls(self, robot: Robot, a: FloatArray, b: FloatArray,
-                    free: Any) -> FloatArray | None:
-        """:meth:`_duck` against the walls and slabs only, every height at once."""
-        floor = self.world.floor_below(a - np.array([0.0, 0.0, robot.height]))
-        if abs(self.world.floor_below(b - np.array([0.0, 0.0, robot.height])) - floor) > 0.5:
-            return None
-        top = min(float(a[2]), float(b[2]))
-        heights = np.arange(top - DUCK_STEP, floor + DUCK_LOWEST - 1e-9, -DUCK_STEP)
+    def _free(self, points: FloatArray, radius: float,  # type: ignore[no-untyped-def]
+              keep_out: float | None = None):
+        """A test of many legs at once (``free(a, b)``: a boolean a leg) against the walls
+        and slabs near ``points`` grown by ``radius``, and with ``keep_out`` the still
+        furniture and people too, grown by ``radius + keep_out`` (as the navigator's
+        ``_leg_free``)."""
+        reach = radius + (keep_out or 0.0) + 1.0
+        lo, hi = points.min(axis=0) - reach, points.max(axis=0) + reach
+        solids = self.world.solid_array
+        near = solids[np.all((solids[:, 0] <= hi) & (solids[:, 1] >= lo), axis=1)]
+        grown = [np.stack([near[:, 0] - radius, near[:, 1] + radius], axis=1)]
+        if keep_out is not None:
+            things = self._furniture(lo, hi)
+            grown.append(np.stack([things[:, 0] - radius - keep_out,
+                                   things[:, 1] + radius + keep_out], axis=1))
+        boxes = np.concatenate(grown)
+
+        def free(a: FloatArray, b: FloatArray) -> np.ndarray:
+            return ~np.asarray(segments_hit_boxes(np.atleast_2d(a), np.atleast_2d(b), boxes))
+
+        return free
+
+    def _heights(self, robot: Robot, point: FloatArray, top: float) -> FloatArray:
+        """The heights a UAV tries under a lintel, highest first: below ``top`` down to
+        ``DUCK_LOWEST`` over the floor under ``point``."""
+        floor = self.world.floor_below(point - np.array([0.0, 0.0, robot.height]))
+        return np.arange(top - DUCK_STEP, floor + DUCK_LOWEST - 1e-9, -DUCK_STEP)
+
+    def _under_lintels(self, robot: Robot, points: FloatArray, radius: float) -> FloatArray:
+        """A UAV's route points in a doorway too high for the lintel, brought down to the
+        highest height that is clear (not below ``DUCK_LOWEST`` over the floor)."""
+        out = np.array(points, dtype=float)
+        nudge = np.array([1e-6, 0.0, 0.0])
+        free = self._free(out, radius)
+        for p in out[~free(out, out + nudge)]:
+            heights = self._heights(robot, p, float(p[2]))
+            lows = np.column_stack([np.full(len(heights), p[0]), np.full(len(heights), p[1]),
+                                    heights])
+            ok = np.flatnonzero(free(lows, lows + nudge)) if len(lows) else np.zeros(0, int)
+            if len(ok):
+                out[np.all(out == p, axis=1), 2] = heights[ok[0]]
+        return out
+
+    def _duck(self, robot: Robot, a: FloatArray, b: FloatArray,
+              free: Any) -> FloatArray | None:
+        """A UAV's leg on one storey blocked overhead (a door's lintel): the same leg lower,
+        coming down before it and climbing back after, at the highest height where all three
+        legs are ``free`` (:meth:`_free`; not below ``DUCK_LOWEST`` over the floor); ``None``
+        if none is."""
+        below = np.array([0.0, 0.0, robot.height])
+        if abs(self.world.floor_below(b - below) - self.world.floor_below(a - below)) > 0.5:
+            return None  # a leg between storeys (a stairwell): not a lintel's
+        heights = self._heights(robot, a, min(float(a[2]), float(b[2])))
         if not len(heights):
             return None
         a2, b2 = np.repeat(a[None], len(heights), 0), np.repeat(b[None], len(heights), 0)
@@ -67,49 +109,3 @@ class Lintels:
             free(b2, np.repeat(b[None], len(heights), 0))
         first = np.flatnonzero(ok)
         return np.array([a, a2[first[0]], b2[first[0]], b]) if len(first) else None
-
-    def _solid_free(self, points: FloatArray, radius: float):  # type: ignore[no-untyped-def]
-        """A test of many legs at once against the walls and slabs near ``points``."""
-        lo, hi = points.min(axis=0) - radius - 1.0, points.max(axis=0) + radius + 1.0
-        solids = self.world.solid_array
-        near = solids[np.all((solids[:, 0] <= hi) & (solids[:, 1] >= lo), axis=1)]
-        grown = np.stack([near[:, 0] - radius, near[:, 1] + radius], axis=1)
-
-        def free(a: FloatArray, b: FloatArray) -> np.ndarray:
-            return ~np.asarray(segments_hit_boxes(np.atleast_2d(a), np.atleast_2d(b), grown))
-
-        return free
-
-    def _under_lintels(self, robot: Robot, points: FloatArray, radius: float) -> FloatArray:
-        """A UAV's route points in a doorway too high for the lintel, brought down to the
-        highest height that is clear (not below ``DUCK_LOWEST`` over the floor)."""
-        out = np.array(points, dtype=float)
-        nudge = np.array([1e-6, 0.0, 0.0])
-        free = self._solid_free(out, radius)
-        for p in out[~free(out, out + nudge)]:
-            floor = self.world.floor_below(p - np.array([0.0, 0.0, robot.height]))
-            heights = np.arange(float(p[2]) - DUCK_STEP, floor + DUCK_LOWEST - 1e-9, -DUCK_STEP)
-            lows = np.column_stack([np.full(len(heights), p[0]), np.full(len(heights), p[1]),
-                                    heights])
-            ok = np.flatnonzero(free(lows, lows + nudge)) if len(lows) else np.zeros(0, int)
-            if len(ok):
-                out[np.all(out == p, axis=1), 2] = heights[ok[0]]
-        return out
-
-    def _duck(self, robot: Robot, a: FloatArray, b: FloatArray, radius: float,
-              furniture: bool = True) -> FloatArray | None:
-        """A UAV's leg on one storey blocked overhead (a door's lintel): the same leg lower,
-        coming down before it and climbing back after, at the highest height that is clear
-        (not below ``DUCK_LOWEST`` over the floor); ``None`` if none is."""
-        floor = self.world.floor_below(a - np.array([0.0, 0.0, robot.height]))
-        if abs(self.world.floor_below(b - np.array([0.0, 0.0, robot.height])) - floor) > 0.5:
-            return None  # a leg between storeys (a stairwell): not a lintel's
-        top = min(float(a[2]), float(b[2]))
-        for z in np.arange(top - DUCK_STEP, floor + DUCK_LOWEST - 1e-9, -DUCK_STEP):
-            a2, b2 = a.copy(), b.copy()
-            a2[2] = b2[2] = z
-            if all(self._leg_free(robot, p, q, radius, furniture)
-                   for p, q in ((a2, b2), (a, a2), (b2, b))):
-                return np.array([a, a2, b2, b])
-        return None
-

@@ -113,7 +113,9 @@ class Navigator(Lintels):
             if float(np.linalg.norm(b - a)) < 1e-9 or self._leg_free(robot, a, b, radius):
                 out.append(b)
                 continue
-            ducked = self._duck(robot, a, b, radius) if robot.kind == "uav" else None
+            ducked = self._duck(robot, a, b, self._free(np.array([a, b]), radius,
+                                                         KEEP_OUT[robot.kind])) \
+                if robot.kind == "uav" else None
             if ducked is not None:
                 out.extend(ducked[1:])
                 continue

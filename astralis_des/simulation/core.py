@@ -106,15 +106,15 @@ class Simulation:
 
     def _make_robot(self, member: MemberSpec) -> Robot:
         d = KIND_DEFAULTS[member.kind]
-        flies = d.rest is not None  # a UAV: it starts landed, and flies at the world's height
-        height = member.height or (self.flight_height if flies else d.height)
+        # a UAV starts landed, and flies at the world's height
+        height = member.height or (self.flight_height if d.flies else d.height)
         if isinstance(member.start, str):
             start = np.array(self.world.rooms[member.start].center)
         else:
             start = np.array(member.start, dtype=float)
         start = start + np.array([0.0, 0.0, d.rest if d.rest is not None else height])
         robot = Robot(member.id, member.kind, member.speed or d.speed, view_of(member),
-                      height, start, accel=d.accel, turn_rate=d.turn_rate, airborne=not flies)
+                      height, start, accel=d.accel, turn_rate=d.turn_rate, airborne=not d.flies)
         robot.trail_t.append(0.0)
         robot.trail_p.append(start.copy())
 
@@ -358,7 +358,6 @@ class Simulation:
         log.info("%s: %s at t=%.1f s", self.mission.spec.name, outcome, self.env.now)
         return result
 
-
     def _wind_down(self) -> None:
         """The mission is over: each robot's tasks end (``cancelled``, "mission ended") and
         the UAVs in the air land where they are (``land`` tasks), within ``LANDING_LIMIT``."""
@@ -367,7 +366,7 @@ class Simulation:
             handler = self.handler(robot.id)
             waits += [handler.done_event(t.id) for t in handler.cancel(reason="mission ended")]
         waits += [self.enqueue(r.id, "land", origin="mission") for r in self.robots.values()
-                  if r.airborne and not r.faulted and KIND_DEFAULTS[r.kind].rest is not None]
+                  if r.airborne and not r.faulted and KIND_DEFAULTS[r.kind].flies]
         if waits:
             over = simpy.AnyOf(self.env, [simpy.AllOf(self.env, waits),
                                           self.env.timeout(LANDING_LIMIT)])

@@ -272,9 +272,8 @@ def log_furniture(rr: Any, rec: Any, placed: Sequence[Placed], world: World) -> 
         mine = [placed[i] for i in idx]
         lo = np.array([p.box.lo for p in mine])
         hi = np.array([p.box.hi for p in mine])
-        colors = [TABLE_II_COLORS.get(str(dict(p.attributes).get("color")), FURNITURE_COLORS[
-            "avatar"]) if p.kind == "avatar" else FURNITURE_COLORS.get(p.kind, (150, 150, 150,
-                                                                              255))
+        colors = [TABLE_II_COLORS.get(str(dict(p.attributes).get("color")),  # an avatar's
+                                      FURNITURE_COLORS.get(p.kind, (150, 150, 150, 255)))
                   for p in mine]
         labels = [p.kind if p.kind != "avatar" else
                   "avatar " + " ".join(str(v) for _, v in p.attributes) for p in mine]

@@ -14,7 +14,7 @@ from astralis_des.world.geometry import Box, FloatArray
 def spiral(box: Box, spacing: float, inward: bool = True,
            margin: float | None = None, min_turns: int = 2) -> FloatArray:
     """A rectangular spiral from the walls to the centre (``inward``) or from the centre to the
-        walls: each side runs a quarter of a ring's spacing nearer the centre than the one before,
+    walls: each side runs a quarter of a ring's spacing nearer the centre than the one before,
     so the path never crosses itself and its corners come ever nearer the centre (farther,
     outward). Rings are ``spacing`` apart (the camera's footprint), closer when needed to
     make at least ``min_turns`` turns; the first side runs ``spacing / 2`` inside the walls,

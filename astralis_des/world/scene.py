@@ -178,15 +178,18 @@ class Scene:
             arrays.append(self._still[rid])
         return np.concatenate(arrays) if arrays else np.zeros((0, 2, 3))
 
+    def patrolling(self, room_id: str) -> list[Placed]:
+        """The room's patrolling bystanders, in the order ``avatar_movers`` lists them."""
+        return [p for p in self.clutter(room_id).placed
+                if dict(p.attributes).get("activity") == "patrolling"]
+
     def avatar_movers(self, rooms: Iterable[str] | None = None) -> list[Mover]:
         """Patrolling bystanders of the furnished rooms (or of ``rooms``), as movers, and a
         patrolling target when no rooms are named."""
         found: list[Mover] = []
         for rid in sorted(self._rooms) if rooms is None else rooms:
-            patrols = [p for p in self.clutter(rid).placed
-                       if dict(p.attributes).get("activity") == "patrolling"]
             found += [self._patrol(f"avatar:{rid}:{i}", rid, p.center, p.size, p.attributes)
-                      for i, p in enumerate(patrols)]
+                      for i, p in enumerate(self.patrolling(rid))]
         if rooms is None and self.target is not None and self.target.mover is not None:
             found.append(self.target.mover)
         return found
