@@ -31,6 +31,7 @@ SAMPLE_STEP = 0.25  # m between sensing samples along a path
 CELL = 0.5  # m, floor cells for coverage
 CHUNK = 16  # looks judged at a time, in time order, until one detects
 BOUND_SHARE = 0.8  # of min_pixels the unhidden bound (sampled coarser) must reach
+PASSES = 6  # interleaved passes over a path's points when judging coverage
 MEMO_SWEEPS = 65536  # coverage answers a world keeps (16-byte digests of their inputs)
 __all__ = ["GeometricSensor", "Sighting", "in_frame"]
 CORNERS = np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5])).reshape(3, -1).T
@@ -127,25 +128,31 @@ class GeometricSensor:
 
     def _coverage(self, view: View, pts: FloatArray, heads: FloatArray, cells: FloatArray,
                   boxes: FloatArray, size: FloatArray, room: Room) -> float:
-        pi = np.repeat(np.arange(len(pts)), len(cells))
-        ci = np.tile(np.arange(len(cells)), len(pts))
+        """A cell is seen when some point of the path shows a target there with enough pixels
+        and in sight. The path's points are taken in ``PASSES`` interleaved passes (every
+        ``PASSES``-th point, then the next...), each judging only the cells no pass has seen:
+        the first pass spans the whole path and sees most of the room, so the later ones have
+        little left to judge. The seen set is the same as judging every pair at once."""
         axes = view.axes(heads)  # once per point of the path, not per pair
-        pi, ci = in_frame(view, pts, heads, cells, size, pi, ci, axes)
-        big = predict_pixels(view, pts[pi], heads[pi], cells[ci], size, None,
-                             pick(axes, pi)) >= view.min_pixels
-        pi, ci = pi[big], ci[big]  # a target there would show enough pixels, if in sight
-        if len(pi) == 0:
-            return 0.0
         seen = np.zeros(len(cells), dtype=bool)
         lo, hi = np.asarray(room.box.lo), np.asarray(room.box.hi)
         in_room = np.all((pts >= lo) & (pts <= hi), axis=1)
-        if not len(boxes):
-            # An empty room is a convex box: from inside it every cell is in sight.
-            seen[ci[in_room[pi]]] = True
-        todo = ~seen[ci]
-        if todo.any():
-            clear = self.scene.line_of_sight(pts[pi[todo]], cells[ci[todo]])
-            seen[ci[todo][clear]] = True
+        for first in range(min(PASSES, len(pts))):
+            rows, todo = np.arange(first, len(pts), PASSES), np.flatnonzero(~seen)
+            if len(todo) == 0:
+                break
+            pi, ci = in_frame(view, pts, heads, cells, size, np.repeat(rows, len(todo)),
+                              np.tile(todo, len(rows)), axes)
+            big = predict_pixels(view, pts[pi], heads[pi], cells[ci], size, None,
+                                 pick(axes, pi)) >= view.min_pixels
+            pi, ci = pi[big], ci[big]  # a target there would show enough pixels, if in sight
+            if not len(boxes):
+                # An empty room is a convex box: from inside it every cell is in sight.
+                seen[ci[in_room[pi]]] = True
+            left = ~seen[ci]
+            if left.any():
+                clear = self.scene.line_of_sight(pts[pi[left]], cells[ci[left]])
+                seen[ci[left][clear]] = True
         return float(seen.mean())
 
 
