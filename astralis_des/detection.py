@@ -147,3 +147,50 @@ def _swath(view: View, drop: float) -> float:
         return 0.0
     fine = widest(np.arange(coarse, coarse + 0.1, 0.01))
     return round(2 * (fine if fine is not None else coarse), 2)
+
+
+PROBES = np.vstack([np.zeros(3), np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5]))
+                    .reshape(3, -1).T])  # the centre and corners of a unit box
+
+
+def shows_unhidden(view: View, eyes: FloatArray, axes: Axes, centres: FloatArray,
+                   size: FloatArray, m: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """For each pair (camera ``eyes[m[p]]`` with ``axes`` rows ``m[p]``, target box at
+    ``centres[n[p]]``): whether the centre or a corner of the box is in the frame and reach
+    (``sensing.in_frame``) and the box would show ``min_pixels`` if nothing hid it
+    (:func:`predict_pixels` with ``sight=None``). The same model, computed in the camera
+    frame: each eye's axes turn the box's probe and sample offsets once, and a pair adds them
+    to its centre's camera coordinates, instead of building every sample in the world."""
+    right, down, forward = (np.asarray(a, dtype=float) for a in axes)
+    d = centres[n] - eyes[m]  # (P, 3)
+    frame = np.stack([right, down, forward])  # (3, M, 3): camera axis, eye, world axis
+    centre = np.einsum("pj,cpj->cp", d, frame[:, m])  # (3, P): x, y, z of the centre
+    size = np.asarray(size, dtype=float)
+    probes = centre[:, :, None] + (frame @ (PROBES * size).T)[:, m]  # (3, P, 9)
+    x, y, z = probes
+    near = x * x + y * y + z * z <= view.reach**2
+    shown = (near & (z > 1e-6) & (np.abs(x) <= z * view.tan_h)
+             & (np.abs(y) <= z * view.tan_v)).any(axis=1)
+    half = size / 2
+    grid = GRIDS[COARSE]  # (3 faces, k, 3): the sample offsets in half sizes, side +1
+    k = grid.shape[1]
+    toward = np.where(d[shown] > 0, -1.0, 1.0)  # (S, 3): the face of each axis facing the eye
+    facing = np.abs(d[shown]) > half  # (S, 3)
+    on_face = (frame @ (np.where(np.eye(3, dtype=bool)[:, None, :], 0.0, grid) * half)
+               .reshape(-1, 3).T).reshape(3, -1, 3, k)  # (3, M, 3 faces, k): in-face offsets
+    out_face = frame * half  # (3, M, 3): half a size along each world axis
+    rows = m[shown]
+    s = (centre[:, shown, None, None] + on_face[:, rows]
+         + (toward[None, :, :] * out_face[:, rows])[:, :, :, None])  # (3, S, 3, k)
+    x, y, z = s
+    inside = (z > NEAR) & (np.abs(x) <= z * view.tan_h) & (np.abs(y) <= z * view.tan_v)
+    if view.range is not None:
+        inside &= z <= view.range
+    height = np.where(facing, np.abs(d[shown]) - half, 0.0)  # the eye over each face's plane
+    face_area = np.array([half[1] * half[2], half[0] * half[2], half[0] * half[1]]) * 4 / k
+    each = (face_area * height)[:, :, None] * view.focal**2 / np.maximum(z, NEAR) ** 3
+    pixels = np.minimum((each * inside * facing[:, :, None]).sum(axis=(1, 2)),
+                        float(view.pixels[0] * view.pixels[1]))
+    out = np.zeros(len(m), dtype=bool)
+    out[np.flatnonzero(shown)] = pixels >= view.min_pixels
+    return out

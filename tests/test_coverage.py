@@ -200,3 +200,33 @@ def test_an_inspect_point_under_a_table_is_skipped_not_failed() -> None:
     assert np.linalg.norm(walked - far, axis=1).min() > 0.5  # never stood at that corner
     others = [p for p in loop if np.linalg.norm(p - far) > 0.1]
     assert all(np.linalg.norm(walked - p, axis=1).min() < 0.3 for p in others)
+
+
+@pytest.mark.parametrize("kind", ["uav", "ugv", "human"])
+def test_coverage_judges_pairs_as_the_detection_model_does(kind: str) -> None:
+    """Coverage judges eye-cell pairs in the camera frame and culls boxes outside the frame
+    first: on random eyes and cells it says exactly what the frustum test (``in_frame``) and
+    the unhidden pixel count (``predict_pixels``) say, pair by pair."""
+    from astralis_des.detection import shows_unhidden
+    from astralis_des.sensing import _cull, in_frame
+    from astralis_des.view import pick
+
+    rng = np.random.default_rng(7)
+    view, size = View.of_kind(kind), np.asarray(TARGET_SIZE)
+    eyes = np.column_stack([rng.uniform(-3, 3, (40, 2)), rng.uniform(0.3, 2.5, 40)])
+    heads = rng.uniform(-np.pi, np.pi, 40)
+    cells = np.column_stack([rng.uniform(-8, 8, (300, 2)), np.full(300, 0.5)])
+    axes = view.axes(heads)
+    m, n = np.repeat(np.arange(40), 300), np.tile(np.arange(300), 40)
+    pi, ci = in_frame(view, eyes, heads, cells, size, m, n, axes)
+    big = predict_pixels(view, eyes[pi], heads[pi], cells[ci], size, None) >= view.min_pixels
+    expected = np.zeros((40, 300), dtype=bool)
+    expected[pi[big], ci[big]] = True
+    assert 0 < expected.sum() < expected.size
+    judged = shows_unhidden(view, eyes, axes, cells, size, m, n).reshape(40, 300)
+    assert np.array_equal(judged, expected)
+    sure, maybe = _cull(view, eyes, pick(axes, np.arange(40)), cells, size)
+    assert expected[sure].all()  # sure: never one the model rejects
+    culled = np.ones((40, 300), dtype=bool)
+    culled[sure] = culled[maybe] = False
+    assert not expected[culled].any()  # culled: never one the model accepts
