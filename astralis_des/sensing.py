@@ -158,7 +158,7 @@ class GeometricSensor:
 
 
 def _cull(view: View, eyes: FloatArray, axes: Axes, centres: FloatArray,
-          size: FloatArray) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
+          size: FloatArray) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
     """The pairs (eye ``m``, target box at ``centres[n]``) sure to pass :func:`in_frame` and
     show ``min_pixels`` unhidden, and those that need the exact tests (as ``nonzero`` index
     pairs); the rest cannot pass them. Box-frustum culling in the camera frame: a box whose
