@@ -279,3 +279,20 @@ def test_a_room_furnished_again_comes_from_memory_and_is_the_room_placed_anew(
     other = furnish(world, "A.1.2.2", 0.8, 12, 4, catalogue)
     assert other == place_room(world, "A.1.2.2", 0.8, stream(12, "clutter", 4), catalogue)
     assert other != first  # another seed, another room
+
+
+def test_erosion_near_a_new_footprint_equals_eroding_the_whole_floor() -> None:
+    """Placing a footprint re-erodes the floor only around it: on random floors and random
+    footprints (at the grid's edges too) the result is the whole floor eroded again."""
+    from astralis_des.world.grids import erode, erode_near
+
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        walk = rng.random((int(rng.integers(5, 40)), int(rng.integers(5, 40)))) > 0.15
+        radius = float(rng.choice([1.5, 2.5, 3.5]))
+        before = erode(walk, radius)
+        i, j = int(rng.integers(walk.shape[0])), int(rng.integers(walk.shape[1]))
+        changed = (slice(i, i + int(rng.integers(1, 6))), slice(j, j + int(rng.integers(1, 6))))
+        after = walk.copy()
+        after[changed] = False
+        assert np.array_equal(erode_near(after, radius, changed, before), erode(after, radius))

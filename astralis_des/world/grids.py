@@ -1,0 +1,94 @@
+"""Summed-area tables, erosion and reachability on a room's floor grid (for furnishing).
+
+Placing one footprint changes the floor only under it, so the erosion of the walkable floor
+is updated in a window around the footprint (:func:`erode_near`), identical to eroding the
+whole grid again.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import ndimage
+
+from astralis_des.world.freespace import CROSS, BoolArray, FreeSpace
+
+Cells = tuple[slice, slice]
+
+
+def summed(mask: BoolArray) -> np.ndarray:
+    """Summed-area table of ``mask``, one row and column of zeros in front."""
+    table = np.zeros((mask.shape[0] + 1, mask.shape[1] + 1), dtype=np.int32)
+    np.cumsum(mask, axis=0, dtype=np.int32, out=table[1:, 1:])
+    np.cumsum(table[1:, 1:], axis=1, out=table[1:, 1:])
+    return table
+
+
+def window(table: np.ndarray, kx: int, ky: int) -> np.ndarray:
+    """``[i, j]``: how many cells of ``mask[i:i + kx, j:j + ky]`` are set (from its table)."""
+    nx, ny = table.shape[0] - 1, table.shape[1] - 1
+    if kx > nx or ky > ny:
+        return np.zeros((0, 0), dtype=np.int32)
+    return np.asarray(table[kx:, ky:] - table[:-kx, ky:] - table[kx:, :-ky] + table[:-kx, :-ky])
+
+
+def window_sum(mask: BoolArray, kx: int, ky: int) -> np.ndarray:
+    return window(summed(mask), kx, ky)
+
+
+def erode(walk: BoolArray, radius: float) -> BoolArray:
+    """Cells whose disk of ``radius`` cells is all ``walk`` (beyond the grid is not).
+
+    The disk is a union of centred rectangles, one per row offset, each tested in O(1) per cell
+    with a summed-area table: a few times faster than a general morphological erosion.
+    """
+    reach = math.floor(radius + 1e-9)
+    nx, ny = walk.shape
+    table = summed(np.pad(~walk, reach, constant_values=True))
+    inner = np.ones(walk.shape, dtype=bool)
+    for di in range(reach + 1):
+        h = math.floor(math.sqrt(radius * radius - di * di) + 1e-9)
+        counts = window(table, 2 * di + 1, 2 * h + 1)
+        inner &= counts[reach - di:reach - di + nx, reach - h:reach - h + ny] == 0
+    return inner
+
+
+def walkable(space: FreeSpace, taken: BoolArray) -> BoolArray:
+    """Where a robot may stand: free floor not taken, and the open floor outside the room."""
+    out: BoolArray = (space.free & ~taken) | (space.open_floor & ~space.inside)
+    return out
+
+
+def erode_near(walk: BoolArray, radius: float, changed: Cells, before: BoolArray) -> BoolArray:
+    """:func:`erode` of ``walk`` when it differs from the walk eroded to ``before`` only in
+    the cells ``changed``: only cells whose disk meets them can change, and their disks read
+    ``walk`` only within ``radius`` of them."""
+    reach = math.floor(radius + 1e-9)
+    out = before.copy()
+    inner, outer = [], []
+    for k, part in enumerate(changed):
+        n = walk.shape[k]
+        lo, hi = max(part.start - reach, 0), min(part.stop + reach, n)
+        if lo >= hi:
+            return out
+        inner.append((lo, hi))
+        outer.append((max(lo - reach, 0), min(hi + reach, n)))
+    local = erode(walk[outer[0][0]:outer[0][1], outer[1][0]:outer[1][1]], radius)
+    (a0, a1), (b0, b1) = inner
+    out[a0:a1, b0:b1] = local[a0 - outer[0][0]:a1 - outer[0][0], b0 - outer[1][0]:b1 - outer[1][0]]
+    return out
+
+
+def reachable(space: FreeSpace, taken: BoolArray, passage: float,
+              walk_eroded: BoolArray | None = None) -> tuple[BoolArray, BoolArray]:
+    """Free cells a robot ``passage`` wide can stand on, and those it reaches from the door;
+    ``walk_eroded``: the walkable floor already eroded by half the passage, when known."""
+    if walk_eroded is None:
+        walk_eroded = erode(walkable(space, taken), passage / 2 / space.cell)
+    eroded = walk_eroded & space.free & ~taken
+    labels, count = ndimage.label(eroded, CROSS)
+    from_door = np.zeros(count + 1, dtype=bool)
+    from_door[labels[space.door & eroded]] = True
+    from_door[0] = False
+    return eroded, from_door[labels]
