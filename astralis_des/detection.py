@@ -137,9 +137,14 @@ def _swath(view: View, drop: float) -> float:
         """The largest offset across the track in ``ys`` at which the target is detected."""
         gx, gy = np.meshgrid(xs, ys, indexing="ij")
         centres = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, -drop)])
-        pixels = predict_pixels(view, np.zeros((len(centres), 3)), np.zeros(len(centres)),
-                                centres, np.asarray(TARGET_SIZE), None).reshape(gx.shape)
-        seen = (pixels >= view.min_pixels).any(axis=0)
+        eye, size = np.zeros((1, 3)), np.asarray(TARGET_SIZE, dtype=float)
+        (_, sure), (_, maybe) = cull(view, eye, view.axes(np.zeros(1)), centres, size,
+                                     reach=False)  # most of the grid is surely in or out
+        shown = np.zeros(len(centres), dtype=bool)
+        shown[sure] = True
+        shown[maybe] = predict_pixels(view, np.zeros((len(maybe), 3)), np.zeros(len(maybe)),
+                                      centres[maybe], size, None) >= view.min_pixels
+        seen = shown.reshape(gx.shape).any(axis=0)
         return float(ys[seen].max()) if seen.any() else None
 
     coarse = widest(np.arange(0.0, reach + 1e-9, 0.1))
@@ -194,3 +199,48 @@ def shows_unhidden(view: View, eyes: FloatArray, axes: Axes, centres: FloatArray
     out = np.zeros(len(m), dtype=bool)
     out[np.flatnonzero(shown)] = pixels >= view.min_pixels
     return out
+
+
+def cull(view: View, eyes: FloatArray, axes: Axes, centres: FloatArray, size: FloatArray,
+         reach: bool = True) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
+    """The pairs (eye ``m``, target box at ``centres[n]``) sure to pass :func:`in_frame` and
+    show ``min_pixels`` unhidden, and those that need the exact tests (as ``nonzero`` index
+    pairs); the rest cannot pass them (nor show a pixel: unless ``reach``, the camera's
+    reach is not tested). Box-frustum culling in the camera frame: a box whose
+    eight corners are in the frame is wholly in it, one whose corners are all beyond one side
+    of it has no probe in it; for a box wholly in the frame, each face turned to the eye shows
+    at least its area times ``f^2 h / z^3`` pixels, ``h`` the eye's height over the face's
+    plane and ``z`` the box's farthest depth. The margins keep rounding on the safe side: a
+    pair the exact tests would judge differently is never decided here."""
+    right, down, forward = axes
+    half = np.asarray(size, dtype=float) / 2
+    corners = PROBES[1:] * np.asarray(size, dtype=float)  # (8, 3) offsets from the centre
+
+    def frame(axis: FloatArray) -> FloatArray:  # (M, N, 8): the corners' coordinate
+        centre = axis @ centres.T - np.einsum("ij,ij->i", axis, eyes)[:, None]
+        return centre[:, :, None] + (axis @ corners.T)[:, None, :]
+
+    x, y, z = frame(right), frame(down), frame(forward)
+    tol = 1e-6
+    side_h, side_v = z * view.tan_h, z * view.tan_v
+    culled = ((z < -tol).all(axis=2) | (x > side_h + tol).all(axis=2)
+              | (-x > side_h + tol).all(axis=2) | (y > side_v + tol).all(axis=2)
+              | (-y > side_v + tol).all(axis=2))
+    d = centres[None, :, :] - eyes[:, None, :]
+    inside = ((z > NEAR + tol) & (np.abs(x) < side_h - tol)
+              & (np.abs(y) < side_v - tol)).all(axis=2)
+    if reach:
+        far = np.einsum("mnj,mnj->mn", d, d)
+        culled |= far > (view.reach + float(np.linalg.norm(half)) + tol) ** 2
+        inside &= far < (view.reach - float(np.linalg.norm(half)) - tol) ** 2
+    if view.range is not None:
+        inside &= (z < view.range - tol).all(axis=2)
+    sure = np.zeros_like(inside)
+    if inside.any() and view.min_pixels <= view.pixels[0] * view.pixels[1]:
+        m, n = np.nonzero(inside)
+        over = np.maximum(np.abs(d[m, n]) - half, 0.0)  # the eye over each face's plane
+        faces = 4 * np.array([half[1] * half[2], half[0] * half[2], half[0] * half[1]])
+        bound = view.focal**2 * (over @ faces) / z[m, n].max(axis=1) ** 3
+        ok = bound >= view.min_pixels * 1.001
+        sure[m[ok], n[ok]] = True
+    return np.nonzero(sure), np.nonzero(~culled & ~sure)

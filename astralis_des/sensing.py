@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from astralis_des.detection import NEAR, Sighting, predict_pixels, shows_unhidden
+from astralis_des.detection import Sighting, cull, predict_pixels, shows_unhidden
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kinds import TARGET_HEIGHT
 from astralis_des.view import Axes, View, look_headings, pick, travel_headings
@@ -141,7 +141,7 @@ class GeometricSensor:
             rows, todo = np.arange(first, len(pts), PASSES), np.flatnonzero(~seen)
             if len(todo) == 0:
                 break
-            sure, maybe = _cull(view, pts[rows], pick(axes, rows), cells[todo], size)
+            sure, maybe = cull(view, pts[rows], pick(axes, rows), cells[todo], size)
             pi, ci = rows[maybe[0]], todo[maybe[1]]
             big = shows_unhidden(view, pts, axes, cells, size, pi, ci)
             # a target there would show enough pixels, if in sight
@@ -155,49 +155,6 @@ class GeometricSensor:
                 clear = self.scene.line_of_sight(pts[pi[left]], cells[ci[left]])
                 seen[ci[left][clear]] = True
         return float(seen.mean())
-
-
-def _cull(view: View, eyes: FloatArray, axes: Axes, centres: FloatArray,
-          size: FloatArray) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
-    """The pairs (eye ``m``, target box at ``centres[n]``) sure to pass :func:`in_frame` and
-    show ``min_pixels`` unhidden, and those that need the exact tests (as ``nonzero`` index
-    pairs); the rest cannot pass them. Box-frustum culling in the camera frame: a box whose
-    eight corners are in the frame is wholly in it, one whose corners are all beyond one side
-    of it has no probe in it; for a box wholly in the frame, each face turned to the eye shows
-    at least its area times ``f^2 h / z^3`` pixels, ``h`` the eye's height over the face's
-    plane and ``z`` the box's farthest depth. The margins keep rounding on the safe side: a
-    pair the exact tests would judge differently is never decided here."""
-    right, down, forward = axes
-    half = np.asarray(size, dtype=float) / 2
-    corners = CORNERS * np.asarray(size, dtype=float)  # (8, 3) offsets from the centre
-
-    def frame(axis: FloatArray) -> FloatArray:  # (M, N, 8): the corners' coordinate
-        centre = axis @ centres.T - np.einsum("ij,ij->i", axis, eyes)[:, None]
-        return centre[:, :, None] + (axis @ corners.T)[:, None, :]
-
-    x, y, z = frame(right), frame(down), frame(forward)
-    tol = 1e-6
-    side_h, side_v = z * view.tan_h, z * view.tan_v
-    culled = ((z < -tol).all(axis=2) | (x > side_h + tol).all(axis=2)
-              | (-x > side_h + tol).all(axis=2) | (y > side_v + tol).all(axis=2)
-              | (-y > side_v + tol).all(axis=2))
-    d = centres[None, :, :] - eyes[:, None, :]
-    reach = np.einsum("mnj,mnj->mn", d, d)
-    culled |= reach > (view.reach + float(np.linalg.norm(half)) + tol) ** 2
-    inside = ((z > NEAR + tol) & (np.abs(x) < side_h - tol)
-              & (np.abs(y) < side_v - tol)).all(axis=2)
-    inside &= reach < (view.reach - float(np.linalg.norm(half)) - tol) ** 2
-    if view.range is not None:
-        inside &= (z < view.range - tol).all(axis=2)
-    sure = np.zeros_like(inside)
-    if inside.any() and view.min_pixels <= view.pixels[0] * view.pixels[1]:
-        m, n = np.nonzero(inside)
-        over = np.maximum(np.abs(d[m, n]) - half, 0.0)  # the eye over each face's plane
-        faces = 4 * np.array([half[1] * half[2], half[0] * half[2], half[0] * half[1]])
-        bound = view.focal**2 * (over @ faces) / z[m, n].max(axis=1) ** 3
-        ok = bound >= view.min_pixels * 1.001
-        sure[m[ok], n[ok]] = True
-    return np.nonzero(sure), np.nonzero(~culled & ~sure)
 
 
 def _within(world: World, room: Room, pts: FloatArray) -> bool:

@@ -207,8 +207,8 @@ def test_coverage_judges_pairs_as_the_detection_model_does(kind: str) -> None:
     """Coverage judges eye-cell pairs in the camera frame and culls boxes outside the frame
     first: on random eyes and cells it says exactly what the frustum test (``in_frame``) and
     the unhidden pixel count (``predict_pixels``) say, pair by pair."""
-    from astralis_des.detection import shows_unhidden
-    from astralis_des.sensing import _cull, in_frame
+    from astralis_des.detection import cull, shows_unhidden
+    from astralis_des.sensing import in_frame
     from astralis_des.view import pick
 
     rng = np.random.default_rng(7)
@@ -225,8 +225,30 @@ def test_coverage_judges_pairs_as_the_detection_model_does(kind: str) -> None:
     assert 0 < expected.sum() < expected.size
     judged = shows_unhidden(view, eyes, axes, cells, size, m, n).reshape(40, 300)
     assert np.array_equal(judged, expected)
-    sure, maybe = _cull(view, eyes, pick(axes, np.arange(40)), cells, size)
+    sure, maybe = cull(view, eyes, pick(axes, np.arange(40)), cells, size)
     assert expected[sure].all()  # sure: never one the model rejects
     culled = np.ones((40, 300), dtype=bool)
     culled[sure] = culled[maybe] = False
     assert not expected[culled].any()  # culled: never one the model accepts
+
+
+@pytest.mark.parametrize(("kind", "drop"), [("uav", 1.475), ("uav", 0.8), ("human", 1.1)])
+def test_swath_culls_nothing_the_pixel_count_would_see(kind: str, drop: float) -> None:
+    """The swath skips the pixel count where the box is surely in or out of the frame: the
+    width is the one a pixel count over the whole grid gives."""
+    from astralis_des.detection import _swath
+
+    view = View.of_kind(kind)
+    reach = min(view.reach, 4.0 * max(drop, 0.5))
+    xs = np.arange(-reach, reach + 1e-9, 0.05)
+
+    def widest(ys: np.ndarray) -> float:  # the pixel count at every point of the grid
+        gx, gy = np.meshgrid(xs, ys, indexing="ij")
+        centres = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, -drop)])
+        pixels = predict_pixels(view, np.zeros((len(centres), 3)), np.zeros(len(centres)),
+                                centres, np.asarray(TARGET_SIZE), None).reshape(gx.shape)
+        return float(ys[(pixels >= view.min_pixels).any(axis=0)].max())
+
+    coarse = widest(np.arange(0.0, reach + 1e-9, 0.1))
+    fine = widest(np.arange(coarse, coarse + 0.1, 0.01))
+    assert _swath.__wrapped__(view, drop) == round(2 * fine, 2)

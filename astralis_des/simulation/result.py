@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 from astralis_des.kernel.events import Record, plain
@@ -58,7 +58,7 @@ class RunResult:
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready summary; wall time is left out so that the file is reproducible."""
-        data = asdict(self)
+        data = asdict(replace(self, events=[]))  # not a deep copy of every event
         data.pop("events")
         data.pop("wall_time")
         data.pop("sensor_time")

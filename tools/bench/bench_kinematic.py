@@ -5,11 +5,18 @@
 Prints absolute times and, measured in the same run, the ratio of a mission's wall time to a
 bare SimPy replay of the very same task schedule (FIFO stores and timeouts, no planning, no
 sensing): the price of routing, coverage and detection over the raw event kernel.
+
+A process keeps what it furnished and the coverage it judged (per room, seed and path), so
+the default mission run again in the same process is faster than its first run: both are
+printed, the first run measured in a fresh process. The 1,000 missions (seeds 0..999, each
+furnished anew) run in fresh worker processes, which inherit nothing from this one.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import multiprocessing
 import statistics
 import subprocess
 import sys
@@ -77,6 +84,11 @@ def main() -> None:
     load_s, mission = timed(lambda: load_mission(mission_file))
     print(f"load mission, world, routing graph:   {load_s:.3f} s (once per world, cached)")
 
+    cold = [first_run(mission_file) for _ in range(3)]
+    first_off = statistics.median(c["off"] for c in cold)
+    first_on = statistics.median(c["on"] for c in cold)
+    first_out = statistics.median(c["outputs"] for c in cold)
+
     import rerun  # noqa: F401  (imported once per process, not per run: not the run's cost)
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -90,32 +102,63 @@ def main() -> None:
     rec_off = [timed(lambda: Simulation(mission).run())[0] for _ in range(args.repeat)]
     on, off = statistics.median(rec_on), statistics.median(rec_off)
     bare = statistics.median(bare_simpy_replay(result) for _ in range(args.repeat))
-    print(f"default mission ({result.end_time:.1f} s simulated, outcome {result.outcome}):")
+    print(f"default mission ({result.end_time:.1f} s simulated, outcome {result.outcome}), run "
+          f"again in this process (median of {args.repeat}):")
     print(f"  outputs + recording on:             {on * 1e3:8.1f} ms  real-time factor "
-          f"{result.end_time / on:8.0f}x (goal >= 2,000x); recording {size / 1024:.0f} KiB")
+          f"{result.end_time / on:8.0f}x (goal >= 3,000x); recording {size / 1024:.0f} KiB")
     print(f"  no outputs:                         {off * 1e3:8.1f} ms  real-time factor "
-          f"{result.end_time / off:8.0f}x")
+          f"{result.end_time / off:8.0f}x (goal >= 4,000x)")
     print(f"  outputs' share of the run:          {statistics.median(writing):8.1%} "
-          f"(timed inside the run)")
+          f"(timed inside the run; goal <= 10%)")
     print(f"  bare SimPy replay of its tasks:     {bare * 1e3:8.2f} ms  -> ours / bare = "
           f"{off / bare:.0f}x")
+    print("  its first run in a fresh process (nothing furnished or judged yet; median of 3):")
+    print(f"    no outputs:                       {first_off * 1e3:8.1f} ms  real-time factor "
+          f"{result.end_time / first_off:8.0f}x (goal >= 4,000x)")
+    print(f"    outputs + recording on:           {first_on * 1e3:8.1f} ms  real-time factor "
+          f"{result.end_time / first_on:8.0f}x (goal >= 3,000x); outputs "
+          f"{first_out / first_on:.1%} of it (goal <= 10%)")
 
     print(f"{args.missions} kinematic missions, recording off (seeds 0..{args.missions - 1}):")
     single = None
     for workers in sorted({1, args.workers}):
         t0 = time.perf_counter()
-        if workers == 1:
-            runs = [run_seed(seed) for seed in range(args.missions)]
-        else:
-            with ProcessPoolExecutor(workers, initializer=load_once) as pool:
-                runs = list(pool.map(run_seed, range(args.missions), chunksize=25))
+        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
+                                 initializer=load_once) as pool:
+            runs = list(pool.map(run_seed, range(args.missions), chunksize=25))
         total = time.perf_counter() - t0
         single = single or total
         outcomes = Counter(outcome for outcome, _ in runs)
-        print(f"  {workers} process{'es' if workers > 1 else ''}: {total:.1f} s (goal < 60 s), "
+        print(f"  {workers} process{'es' if workers > 1 else ''}: {total:.1f} s (goal <= 20 s on 2), "
               f"{args.missions / total:.0f} missions/s, mean real-time factor "
               f"{sum(t for _, t in runs) / total:.0f}x; speed-up {single / total:.2f}; "
               f"outcomes {dict(outcomes)}")
+
+
+FIRST_RUN = """
+import json, sys, tempfile, time
+from pathlib import Path
+from astralis_des import Simulation, load_mission
+import rerun
+mission = load_mission(Path(sys.argv[1]))
+t0 = time.perf_counter()
+sim = Simulation(mission, out_dir=Path(tempfile.mkdtemp()) if sys.argv[2] == "on" else None)
+sim.run()
+print(json.dumps({"wall": time.perf_counter() - t0, "outputs": sim.outputs_time}))
+"""
+
+
+def first_run(mission_file: Path) -> dict[str, float]:
+    """The default mission's first run in a fresh process, without and with outputs."""
+    out = {}
+    for mode in ("off", "on"):
+        done = subprocess.run([sys.executable, "-c", FIRST_RUN, str(mission_file), mode],
+                              capture_output=True, text=True, check=True, cwd=ROOT)
+        measured = json.loads(done.stdout.strip().splitlines()[-1])
+        out[mode] = measured["wall"]
+        if mode == "on":
+            out["outputs"] = measured["outputs"]
+    return out
 
 
 _MISSION = None
