@@ -11,7 +11,10 @@ Measured in one run, on this machine:
   ratio), the real-time factor, and each sensor's share (``camera`` renders frames,
   ``camera_cull`` tests whether the target can be in view at all);
 - the recording's share (the same run without outputs);
-- the same mission after a one-hour idle wait (``assignment.start_at: 3600``).
+- the same mission after a one-hour idle wait (``assignment.start_at: 3600``);
+- a team-size curve (``--teams 4 8 10 16``): the default mission with half the team UAVs and
+  half UGVs, in physics with the default sensors and no outputs: real-time factor, time
+  inside ``stepSimulation`` and its overhead ratio per team size (goal: >= 10x with 10).
 """
 
 from __future__ import annotations
@@ -64,6 +67,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--mission", default=str(ROOT / "missions" / "urban_search.yaml"))
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--teams", type=int, nargs="*", default=[4, 8, 10, 16],
+                        help="team sizes of the scaling curve (none: skip it)")
     args = parser.parse_args()
     mission = load_mission(args.mission).with_changes(fidelity="physics")
     raw = raw_pybullet(mission)
@@ -107,6 +112,30 @@ def main() -> None:
     idle = statistics.median(run(waited, None)[0] for _ in range(args.repeat))
     print(f"  the same after a one-hour idle wait: {idle:.2f} s against {bare:.2f} s "
           f"({(idle - bare) / bare:+.1%}; goal < +5%)")
+    if args.teams:
+        team_curve(mission, args.teams)
+
+
+def team(size: int) -> list[dict[str, object]]:
+    """``size`` robots in the street before building A: UAVs in a row 2 m apart, UGVs in a
+    row 3 m apart behind them (half each; one more UAV when ``size`` is odd)."""
+    uavs, ugvs = (size + 1) // 2, size // 2
+    return ([{"id": f"uav{k + 1}", "kind": "uav", "start": [84.0 + 2 * k, 60.0, 0.0]}
+             for k in range(uavs)]
+            + [{"id": f"ugv{k + 1}", "kind": "ugv", "start": [84.0 + 3 * k, 66.0, 0.0]}
+               for k in range(ugvs)])
+
+
+def team_curve(mission, sizes: list[int]) -> None:  # type: ignore[no-untyped-def]
+    print("team-size curve: the default mission with n robots (half UAVs, half UGVs), physics, "
+          "default sensors, no outputs:")
+    print("  robots  simulated      wall  real-time  in stepSimulation  overhead  outcome")
+    for size in sizes:
+        wall, result, stepping, steps, _, _ = run(mission.with_changes(team=team(size)), None)
+        goal = " (goal >= 10x)" if size == 10 else ""
+        print(f"  {size:6d}  {result.end_time:7.1f} s  {wall:6.2f} s  {result.end_time / wall:8.1f}x"
+              f"  {stepping:7.2f} s ({stepping / steps * 1e6:4.0f} us/step)  "
+              f"{wall / stepping:7.2f}  {result.outcome} by {result.found_by}{goal}")
 
 
 if __name__ == "__main__":
