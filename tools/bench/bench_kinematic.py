@@ -129,7 +129,8 @@ def main() -> None:
         total = time.perf_counter() - t0
         single = single or total
         outcomes = Counter(outcome for outcome, _ in runs)
-        print(f"  {workers} process{'es' if workers > 1 else ''}: {total:.1f} s (goal <= 20 s on 2), "
+        print(f"  {workers} process{'es' if workers > 1 else ''}: {total:.1f} s "
+              f"(goal <= 20 s on 2), "
               f"{args.missions / total:.0f} missions/s, mean real-time factor "
               f"{sum(t for _, t in runs) / total:.0f}x; speed-up {single / total:.2f}; "
               f"outcomes {dict(outcomes)}")

@@ -133,7 +133,8 @@ def team_curve(mission, sizes: list[int]) -> None:  # type: ignore[no-untyped-de
     for size in sizes:
         wall, result, stepping, steps, _, _ = run(mission.with_changes(team=team(size)), None)
         goal = " (goal >= 10x)" if size == 10 else ""
-        print(f"  {size:6d}  {result.end_time:7.1f} s  {wall:6.2f} s  {result.end_time / wall:8.1f}x"
+        print(f"  {size:6d}  {result.end_time:7.1f} s  {wall:6.2f} s  "
+              f"{result.end_time / wall:8.1f}x"
               f"  {stepping:7.2f} s ({stepping / steps * 1e6:4.0f} us/step)  "
               f"{wall / stepping:7.2f}  {result.outcome} by {result.found_by}{goal}")
 
