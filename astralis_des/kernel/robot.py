@@ -86,14 +86,14 @@ class Motion:
         s = float(self.profile.arc(t - self.t0))
         legs = np.flatnonzero(np.diff(self.cum) > 1e-9)
         begun = legs[self.cum[legs] <= s + 1e-9]
-        flat = [(i, int(leg)) for i, leg in enumerate(begun)
-                if np.hypot(*np.diff(self.points[[leg, leg + 1]], axis=0)[0][:2]) > 1e-6]
-        if not flat:
+        steps = np.diff(self.points, axis=0)[begun]
+        flat = np.flatnonzero(np.hypot(steps[:, 0], steps[:, 1]) > 1e-6)
+        if not len(flat):
             return before
         headings = self.profile.headings
         if self.turn_rate is not None and len(headings):
-            return float(headings[flat[-1][0]])
-        dx, dy = (self.points[flat[-1][1] + 1] - self.points[flat[-1][1]])[:2]
+            return float(headings[flat[-1]])
+        dx, dy = steps[flat[-1], :2]
         return float(np.arctan2(dy, dx))
 
     def vertices_until(self, t: float) -> tuple[FloatArray, FloatArray]:
