@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -43,12 +44,18 @@ _TIE = 1e-5  # m: a clearance equal to the radius is not free, however float32 r
 @dataclass(frozen=True, eq=False)
 class _FieldGrid:
     """An occupancy grid in any dimension with its distance field: the queries both maps
-    answer alike, indexed ``[i, j(, k)]``."""
+    answer alike, indexed ``[i, j(, k)]``. Subclasses give ``occupied`` and ``distance``
+    (metres to the nearest occupied cell's centre, float32)."""
 
     origin: FloatArray  # corner of cell (0, ...)
     resolution: float
-    occupied: BoolArray
-    distance: NDArray[np.float32]  # metres to the nearest occupied cell's centre
+
+    if TYPE_CHECKING:
+        @property
+        def occupied(self) -> BoolArray: ...
+
+        @property
+        def distance(self) -> NDArray[np.float32]: ...
 
     def cell_of(self, points: ArrayLike) -> IntArray:
         """``(N, D)`` indices of the cells holding ``points`` (possibly outside the grid)."""
@@ -74,6 +81,9 @@ class _FieldGrid:
 class GridMap(_FieldGrid):
     """A 2-D occupancy grid (``(nx, ny)``) and its distance field."""
 
+    occupied: BoolArray
+    distance: NDArray[np.float32]
+
     @classmethod
     def from_occupancy(cls, occupied: BoolArray, origin: ArrayLike,
                        resolution: float) -> GridMap:
@@ -85,7 +95,34 @@ class GridMap(_FieldGrid):
 @dataclass(frozen=True, eq=False)
 class VoxelMap(_FieldGrid):
     """A 3-D occupancy grid (``(nx, ny, nz)``) and its distance field; arrays are read-only
-    and may be shared."""
+    and may be shared. Built from boxes, the map keeps the squared distance in cells
+    (``squared``, 2 bytes a voxel) and answers clearance queries from it; the full
+    occupancy and float32 distance arrays are made only when asked for (they would take
+    5 bytes more a voxel, and most of a fresh process's time building the map)."""
+
+    squared: NDArray[np.unsignedinteger] | None = None  # (nx, ny, nz) cells^2 (a view)
+    dense: tuple[BoolArray, NDArray[np.float32]] | None = None  # occupied, distance
+
+    @cached_property
+    def occupied(self) -> BoolArray:
+        if self.dense is not None:
+            return self.dense[0]
+        assert self.squared is not None
+        return _frozen(np.equal(self.squared, 0))
+
+    @cached_property
+    def distance(self) -> NDArray[np.float32]:
+        if self.dense is not None:
+            return self.dense[1]
+        assert self.squared is not None
+        return _frozen(_metres(self.squared, self.resolution))
+
+    @cached_property
+    def _field(self) -> _Field:
+        if self.squared is None:
+            return _Field(self.distance)
+        resolution = self.resolution
+        return _Field(self.squared, lambda cells2: _metres(cells2, resolution))
 
     def segment_free(self, p0: ArrayLike, p1: ArrayLike, radius: float) -> bool:
         """Is every point of the segment, sampled every half voxel, free for ``radius``?"""
@@ -131,15 +168,13 @@ def from_boxes(boxes: ArrayLike, lo: ArrayLike, hi: ArrayLike,
     stop = np.ceil((corners[:, 1] - lo_) / resolution - _EPS).astype(np.int64)
     first, stop = np.clip(first, 0, (nx, ny, nz)), np.clip(stop, 0, (nx, ny, nz))
     keep = np.all(stop > first, axis=1)
-    d2 = _squared_distances(first[keep], stop[keep], (nx, ny, nz))
-    distance = np.sqrt(d2, dtype=np.float32)
-    distance *= np.float32(resolution)
     if not keep.any():
-        distance[:] = np.inf
+        occupied = np.zeros((nx, ny, nz), dtype=bool)
+        distance = np.full((nx, ny, nz), np.inf, dtype=np.float32)
+        return VoxelMap(_frozen(lo_), resolution, dense=(_frozen(occupied), _frozen(distance)))
+    d2 = _squared_distances(first[keep], stop[keep], (nx, ny, nz))
     # Computed layer-major (z, x, y) so each layer is contiguous; exposed as (x, y, z) views.
-    occupied = (d2 == 0).transpose(1, 2, 0)
-    return VoxelMap(_frozen(lo_), resolution, _frozen(occupied),
-                    _frozen(distance.transpose(1, 2, 0)))
+    return VoxelMap(_frozen(lo_), resolution, squared=_frozen(d2.transpose(1, 2, 0)))
 
 
 def world_map(world: World, extra: ArrayLike | None = None, resolution: float | None = None,
@@ -196,8 +231,8 @@ def from_boxes_rasterised(boxes: ArrayLike, lo: ArrayLike, hi: ArrayLike,
     occupied = np.zeros(shape, dtype=bool)
     for (i0, j0, k0), (i1, j1, k1) in zip(first.tolist(), stop.tolist(), strict=True):
         occupied[i0:i1, j0:j1, k0:k1] = True
-    return VoxelMap(_frozen(lo_), resolution, _frozen(occupied),
-                    _frozen(_edt(occupied, resolution)))
+    return VoxelMap(_frozen(lo_), resolution,
+                    dense=(_frozen(occupied), _frozen(_edt(occupied, resolution))))
 
 
 def _squared_distances(first: IntArray, stop: IntArray,
@@ -250,10 +285,22 @@ def _center_of(cells: ArrayLike, origin: FloatArray, resolution: float) -> Float
     return origin + (c + 0.5) * resolution
 
 
-class _Field:
-    """Fast lookups in a field of any memory layout: one ``take`` on its flat memory."""
+def _metres(squared: NDArray[np.unsignedinteger], resolution: float) -> NDArray[np.float32]:
+    """Squared distances in cells as float32 metres (``np.sqrt(a, dtype=...)`` takes 9 times
+    as long on a map: cast, then the root in place)."""
+    out = squared.astype(np.float32)
+    np.sqrt(out, out=out)
+    out *= np.float32(resolution)
+    return out
 
-    def __init__(self, field: NDArray[np.float32]) -> None:
+
+class _Field:
+    """Fast lookups in a field of any memory layout: one ``take`` on its flat memory, and
+    ``convert`` on the values taken (as on the whole field: the same numbers)."""
+
+    def __init__(self, field: NDArray[Any],
+                 convert: Callable[[NDArray[Any]], NDArray[np.float32]] | None = None) -> None:
+        self.convert = convert
         order = np.argsort(field.strides)[::-1]  # axes from the slowest-varying in memory
         dense = field.transpose(order)
         if not dense.flags.c_contiguous:
@@ -267,7 +314,8 @@ class _Field:
     def at(self, cells: IntArray) -> FloatArray:
         """``(N,)`` values at ``cells``; 0 for cells outside the field."""
         inside = ((cells >= 0) & (cells < self.shape)).all(axis=1)
-        values = self.flat.take(np.where(inside, cells @ self.steps, 0)).astype(float)
+        taken = self.flat.take(np.where(inside, cells @ self.steps, 0))
+        values = (taken if self.convert is None else self.convert(taken)).astype(float)
         values[~inside] = 0.0
         return values
 
