@@ -122,3 +122,23 @@ def test_densify_keeps_vertices_and_bounds_the_spacing() -> None:
     dense = densify(points, 0.3)
     assert np.linalg.norm(np.diff(dense, axis=0), axis=1).max() <= 0.3
     assert all(any(np.allclose(v, d) for d in dense) for v in points)
+
+
+def test_clearance_and_occupied_cells_read_the_squared_distances_as_the_full_field() -> None:
+    """A map built from boxes answers clearance from its squared distances and lists the
+    occupied voxels above a height layer by layer: the same numbers, in the same order, as
+    the full float32 field and ``np.argwhere`` over the whole occupancy."""
+    rng = np.random.default_rng(5)
+    lo = rng.uniform(0, 4, (12, 3))
+    boxes = np.stack([lo, lo + rng.uniform(0.1, 1.5, (12, 3))], axis=1)
+    m = from_boxes(boxes, (0, 0, -0.4), (6, 6, 6), RES)
+    assert m.squared is not None
+    points = rng.uniform(-0.5, 6.5, (2000, 3))
+    cells = m.cell_of(points)
+    inside = ((cells >= 0) & (cells < m.distance.shape)).all(axis=1)
+    expected = np.zeros(len(points))
+    expected[inside] = m.distance[tuple(cells[inside].T)]
+    assert np.array_equal(m.clearance(points), expected)
+    centres = m.center_of(np.argwhere(m.occupied))
+    above = m.center_of(m.occupied_cells(above=1.0))
+    assert len(above) and np.array_equal(above, centres[centres[:, 2] > 1.0])

@@ -203,8 +203,7 @@ class Navigator(Lintels):
         voxels = self.map
         cache: dict[str, FloatArray] = voxels.__dict__.setdefault("_occupied_points", {})
         if "above" not in cache:
-            centres = voxels.center_of(np.argwhere(voxels.occupied))
-            cache["above"] = centres[centres[:, 2] > 0.05]
+            cache["above"] = voxels.center_of(voxels.occupied_cells(above=0.05))
         return cache["above"]
 
     @property

@@ -117,6 +117,23 @@ class VoxelMap(_FieldGrid):
         assert self.squared is not None
         return _frozen(_metres(self.squared, self.resolution))
 
+    def occupied_cells(self, above: float) -> IntArray:
+        """Indices of the occupied voxels whose centres lie higher than ``above``, in the
+        order of ``np.argwhere(occupied)`` (only the layers above are looked at)."""
+        nz = (self.squared if self.squared is not None else self.occupied).shape[2]
+        layers = np.column_stack([np.zeros((nz, 2)), np.arange(nz)])
+        higher = np.flatnonzero(self.center_of(layers)[:, 2] > above)
+        if not len(higher):
+            return np.zeros((0, 3), dtype=np.intp)
+        k0 = int(higher[0])
+        if self.squared is None:
+            cells: IntArray = np.argwhere(self.occupied[:, :, k0:])
+        else:  # layer by layer, as the squared distances lie in memory, then in (x, y, z) order
+            zxy = np.argwhere(np.equal(self.squared.transpose(2, 0, 1)[k0:], 0))
+            cells = zxy[np.lexsort((zxy[:, 0], zxy[:, 2], zxy[:, 1]))][:, [1, 2, 0]]
+        cells[:, 2] += k0
+        return cells
+
     @cached_property
     def _field(self) -> _Field:
         if self.squared is None:
