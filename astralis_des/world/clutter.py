@@ -18,15 +18,7 @@ from astralis_des.streams import stream
 from astralis_des.world.catalogue import Catalogue, agree, avatar_size, default_catalogue
 from astralis_des.world.freespace import BoolArray, FreeSpace, room_free_space
 from astralis_des.world.geometry import Box
-from astralis_des.world.grids import (
-    erode,
-    erode_near,
-    reachable,
-    summed,
-    walkable,
-    window,
-    window_sum,
-)
+from astralis_des.world.grids import erode, erode_near, padded, reachable, summed, walkable, window
 from astralis_des.world.model import Room, World
 
 ATTEMPTS = 30  # spots tried per item before it is skipped
@@ -81,10 +73,19 @@ class Occupancy:
 
     @classmethod
     def empty(cls, space: FreeSpace, keepout: BoolArray, passage: float) -> Occupancy:
+        """Nothing placed yet; the empty room's reachability is worked out once per room
+        and passage (its arrays are replaced, never changed, as footprints are placed)."""
         taken = np.zeros(space.shape, dtype=bool)
-        walk_eroded = erode(walkable(space, taken), passage / 2 / space.cell)
-        return cls(taken, taken.copy(), keepout,
-                   reachable(space, taken, passage, walk_eroded)[1], walk_eroded)
+        kept: dict[float, tuple[BoolArray, BoolArray]] = \
+            space.__dict__.setdefault("_empty_reach", {})
+        if passage not in kept:
+            walk_eroded = erode(walkable(space, taken), passage / 2 / space.cell)
+            reach = reachable(space, taken, passage, walk_eroded)[1]
+            reach.setflags(write=False)
+            walk_eroded.setflags(write=False)
+            kept[passage] = (reach, walk_eroded)
+        reach, walk_eroded = kept[passage]
+        return cls(taken, taken.copy(), keepout, reach, walk_eroded)
 
     def settle(self, space: FreeSpace, passage: float) -> None:
         """Reachability again after footprints were stamped by hand."""
@@ -297,9 +298,9 @@ def _candidates(space: FreeSpace, occupied: Occupancy, w: float, d: float, again
     """Each layout with the ``(n, 2)`` lower corner cells where it fits."""
     allowed = space.free & ~occupied.keepout & ~occupied.halo
     grow = math.ceil(clearance / space.cell - 1e-6)
-    taken = np.pad(occupied.taken, grow)
+    taken = padded(occupied.taken, grow, False)
     allowed_table, taken_table = summed(allowed), summed(taken)
-    sides = space.wall_sides() if against_wall else None
+    sides = _wall_tables(space) if against_wall else None
     found = []
     for layout in _layouts(w, d, space.cell, against_wall, turn):
         kx, ky = layout.cells
@@ -315,15 +316,23 @@ def _candidates(space: FreeSpace, occupied: Occupancy, w: float, d: float, again
     return found
 
 
-def _backs_onto_wall(side: BoolArray, wall: int, kx: int, ky: int,
+def _wall_tables(space: FreeSpace) -> list[np.ndarray]:
+    """Summed-area tables of the cells along a wall towards -x, +x, -y, +y (once a room)."""
+    kept: list[np.ndarray] = space.__dict__.get("_wall_tables") or \
+        space.__dict__.setdefault("_wall_tables", [summed(s) for s in space.wall_sides()])
+    return kept
+
+
+def _backs_onto_wall(side: np.ndarray, wall: int, kx: int, ky: int,
                      shape: tuple[int, ...]) -> np.ndarray:
-    """Corners whose window's back row or column lies wholly along a wall on that side."""
+    """Corners whose window's back row or column lies wholly along a wall on that side
+    (``side``: the summed-area table of the cells along that wall)."""
     nx, ny = shape
     if wall in (0, 1):
-        column = window_sum(side, 1, ky)
+        column = window(side, 1, ky)
         start = 0 if wall == 0 else kx - 1
         return np.asarray(column[start:start + nx, :ny] == ky)
-    row = window_sum(side, kx, 1)
+    row = window(side, kx, 1)
     start = 0 if wall == 2 else ky - 1
     return np.asarray(row[:nx, start:start + ny] == kx)
 
