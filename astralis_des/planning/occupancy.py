@@ -102,6 +102,7 @@ class VoxelMap(_FieldGrid):
 
     squared: NDArray[np.unsignedinteger] | None = None  # (nx, ny, nz) cells^2 (a view)
     dense: tuple[BoolArray, NDArray[np.float32]] | None = None  # occupied, distance
+    blocks: tuple[IntArray, IntArray] | None = None  # with squared: the boxes' cell ranges
 
     @cached_property
     def occupied(self) -> BoolArray:
@@ -126,13 +127,23 @@ class VoxelMap(_FieldGrid):
         if not len(higher):
             return np.zeros((0, 3), dtype=np.intp)
         k0 = int(higher[0])
-        if self.squared is None:
+        if self.blocks is None:
             cells: IntArray = np.argwhere(self.occupied[:, :, k0:])
-        else:  # layer by layer, as the squared distances lie in memory, then in (x, y, z) order
-            zxy = np.argwhere(np.equal(self.squared.transpose(2, 0, 1)[k0:], 0))
-            cells = zxy[np.lexsort((zxy[:, 0], zxy[:, 2], zxy[:, 1]))][:, [1, 2, 0]]
-        cells[:, 2] += k0
-        return cells
+            cells[:, 2] += k0
+            return cells
+        # the occupied voxels are those of the boxes' cell ranges: listed box by box, then
+        # each once, in the order of np.argwhere
+        shape = np.array(self.squared.shape if self.squared is not None else (0, 0, 0))
+        flat = []
+        for first, stop in zip(*self.blocks, strict=True):
+            first = np.maximum(first, (0, 0, k0))
+            if np.all(stop > first):
+                grid = np.meshgrid(*(np.arange(a, b) for a, b in zip(first, stop, strict=True)),
+                                   indexing="ij")
+                flat.append(np.ravel_multi_index(tuple(g.ravel() for g in grid), shape))
+        if not flat:
+            return np.zeros((0, 3), dtype=np.intp)
+        return np.column_stack(np.unravel_index(np.unique(np.concatenate(flat)), shape))
 
     @cached_property
     def _field(self) -> _Field:
@@ -191,7 +202,8 @@ def from_boxes(boxes: ArrayLike, lo: ArrayLike, hi: ArrayLike,
         return VoxelMap(_frozen(lo_), resolution, dense=(_frozen(occupied), _frozen(distance)))
     d2 = _squared_distances(first[keep], stop[keep], (nx, ny, nz))
     # Computed layer-major (z, x, y) so each layer is contiguous; exposed as (x, y, z) views.
-    return VoxelMap(_frozen(lo_), resolution, squared=_frozen(d2.transpose(1, 2, 0)))
+    return VoxelMap(_frozen(lo_), resolution, squared=_frozen(d2.transpose(1, 2, 0)),
+                    blocks=(_frozen(first[keep]), _frozen(stop[keep])))
 
 
 def world_map(world: World, extra: ArrayLike | None = None, resolution: float | None = None,
