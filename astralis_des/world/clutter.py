@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -243,9 +244,9 @@ def place_in(space: FreeSpace, occupied: Occupancy, footprint: Sequence[float],
     bounds = np.cumsum(sizes)
     for pick in tries:
         which = int(np.searchsorted(bounds, pick, side="right"))
-        layout, corners = candidates[which]
+        layout, corners, width = candidates[which]
         offset = int(pick - (bounds[which - 1] if which else 0))
-        spot = layout.spot(space, corners[offset])
+        spot = layout.spot(space, np.divmod(corners[offset], width))
         box = _footprint_box(spot)
         before = (occupied.taken.copy(), occupied.halo.copy())
         occupied.stamp(space, box, clearance)
@@ -268,7 +269,7 @@ class _Layout:
     yaw: float
     wall: int  # 0..3: wall towards -x, +x, -y, +y; -1: free-standing
 
-    def spot(self, space: FreeSpace, corner: np.ndarray) -> Spot:
+    def spot(self, space: FreeSpace, corner: tuple[Any, Any]) -> Spot:
         i, j = int(corner[0]), int(corner[1])
         (ex, ey), (kx, ky), c = self.extent, self.cells, space.cell
         x0, y0 = space.origin[0] + i * c, space.origin[1] + j * c
@@ -294,8 +295,9 @@ def _layouts(w: float, d: float, cell: float, against_wall: bool,
 
 
 def _candidates(space: FreeSpace, occupied: Occupancy, w: float, d: float, against_wall: bool,
-                clearance: float, turn: bool) -> list[tuple[_Layout, np.ndarray]]:
-    """Each layout with the ``(n, 2)`` lower corner cells where it fits."""
+                clearance: float, turn: bool) -> list[tuple[_Layout, np.ndarray, int]]:
+    """Each layout with the lower corner cells where it fits (flat indices into a grid of
+    the width given with them)."""
     allowed = space.free & ~occupied.keepout & ~occupied.halo
     grow = math.ceil(clearance / space.cell - 1e-6)
     taken = padded(occupied.taken, grow, False)
@@ -310,9 +312,9 @@ def _candidates(space: FreeSpace, occupied: Occupancy, w: float, d: float, again
         fits &= window(taken_table, kx + 2 * grow, ky + 2 * grow) == 0
         if sides is not None:
             fits &= _backs_onto_wall(sides[layout.wall], layout.wall, kx, ky, fits.shape)
-        corners = np.argwhere(fits)
+        corners = np.flatnonzero(fits)  # in the order of np.argwhere, as flat indices
         if len(corners):
-            found.append((layout, corners))
+            found.append((layout, corners, fits.shape[1]))
     return found
 
 
