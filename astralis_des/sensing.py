@@ -102,38 +102,40 @@ class GeometricSensor:
         ``points`` (facing its direction of travel, or ``headings`` given per point)."""
         if robot.view is None:
             return 0.0
-        cells = floor_cells(room)
+        full = floor_cells(room)
         boxes = self.scene.still_boxes([room.id])
+        keep = np.ones(len(full), dtype=bool)
         if len(boxes):
-            under = np.any(np.all((cells[:, None, :2] >= boxes[None, :, 0, :2]) &
-                                  (cells[:, None, :2] <= boxes[None, :, 1, :2]), axis=2), axis=1)
-            cells = cells[~under]
-            if len(cells) == 0:
+            keep = ~np.any(np.all((full[:, None, :2] >= boxes[None, :, 0, :2]) &
+                                  (full[:, None, :2] <= boxes[None, :, 1, :2]), axis=2), axis=1)
+            if not keep.any():
                 return 0.0
         view = robot.view
         pts, heads = _sample_path(robot, np.asarray(points, dtype=float), headings)
         size = np.asarray(self.target.size, dtype=float)
         if not _within(self.scene.world, room, pts):  # another room's furniture may matter
-            return self._coverage(view, pts, heads, cells, boxes, size, room)
+            return self._coverage(view, pts, heads, full, keep, boxes, size, room)
         # the answer depends on these alone: kept on the world (a tune's next trial, a study's
         # next variant flies the same sweep of the same furnished room)
-        digest = hashlib.blake2b(b"".join(np.ascontiguousarray(a, dtype=float).tobytes()
-                                          for a in (pts, heads, boxes, size)),
-                                 digest_size=16).digest()
+        digest = _digest(pts, heads, boxes, size)
         memo = self.scene.world.memo("coverage", MEMO_SWEEPS)
         key = (view, room.id, len(pts), len(boxes), digest)
         if key not in memo:
-            memo[key] = self._coverage(view, pts, heads, cells, boxes, size, room)
+            memo[key] = self._coverage(view, pts, heads, full, keep, boxes, size, room)
         return float(memo[key])
 
-    def _coverage(self, view: View, pts: FloatArray, heads: FloatArray, cells: FloatArray,
-                  boxes: FloatArray, size: FloatArray, room: Room) -> float:
-        """A cell is seen when some point of the path shows a target there with enough pixels
-        and in sight. The path's points are taken in ``PASSES`` interleaved passes (every
-        ``PASSES``-th point, then the next...), each judging only the cells no pass has seen:
-        the first pass spans the whole path and sees most of the room, so the later ones have
-        little left to judge. The seen set is the same as judging every pair at once."""
+    def _coverage(self, view: View, pts: FloatArray, heads: FloatArray, full: FloatArray,
+                  keep: np.ndarray, boxes: FloatArray, size: FloatArray, room: Room) -> float:
+        """A cell (of ``full[keep]``) is seen when some point of the path shows a target
+        there with enough pixels and in sight. The path's points are taken in ``PASSES``
+        interleaved passes (every ``PASSES``-th point, then the next...), each judging only
+        the cells no pass has seen: the first pass spans the whole path and sees most of the
+        room, so the later ones have little left to judge. The seen set is the same as
+        judging every pair at once. Which pairs of the first pass would show enough pixels
+        does not depend on the furniture: it is kept per room and path (the next seed
+        furnishes the room anew, the UAV flies the same sweep)."""
         axes = view.axes(heads)  # once per point of the path, not per pair
+        cells = full[keep]
         seen = np.zeros(len(cells), dtype=bool)
         lo, hi = np.asarray(room.box.lo), np.asarray(room.box.hi)
         in_room = np.all((pts >= lo) & (pts <= hi), axis=1)
@@ -141,12 +143,12 @@ class GeometricSensor:
             rows, todo = np.arange(first, len(pts), PASSES), np.flatnonzero(~seen)
             if len(todo) == 0:
                 break
-            sure, maybe = cull(view, pts[rows], pick(axes, rows), cells[todo], size)
-            pi, ci = rows[maybe[0]], todo[maybe[1]]
-            big = shows_unhidden(view, pts, axes, cells, size, pi, ci)
-            # a target there would show enough pixels, if in sight
-            pi = np.concatenate([rows[sure[0]], pi[big]])
-            ci = np.concatenate([todo[sure[1]], ci[big]])
+            if first == 0:
+                shown = self._first_pass(view, pts, heads, axes, full, size, room)[:, keep]
+                r, c = np.nonzero(shown)
+                pi, ci = rows[r], c
+            else:
+                pi, ci = _shown(view, pts, axes, cells, size, rows, todo)
             if not len(boxes):
                 # An empty room is a convex box: from inside it every cell is in sight.
                 seen[ci[in_room[pi]]] = True
@@ -155,6 +157,38 @@ class GeometricSensor:
                 clear = self.scene.line_of_sight(pts[pi[left]], cells[ci[left]])
                 seen[ci[left][clear]] = True
         return float(seen.mean())
+
+    def _first_pass(self, view: View, pts: FloatArray, heads: FloatArray, axes: Axes,
+                    full: FloatArray, size: FloatArray, room: Room) -> np.ndarray:
+        """``(rows, cells)``: whether the first pass's points (every ``PASSES``-th) would show
+        a target on each of the room's floor cells with enough pixels, if nothing hid it."""
+        memo = self.scene.world.memo("first_pass", MEMO_SWEEPS)
+        key = (view, room.id, len(pts), _digest(pts, heads, size))
+        rows = np.arange(0, len(pts), PASSES)
+        if key not in memo:
+            pi, ci = _shown(view, pts, axes, full, size, rows, np.arange(len(full)))
+            shown = np.zeros((len(rows), len(full)), dtype=bool)
+            shown[pi // PASSES, ci] = True
+            memo[key] = np.packbits(shown, axis=1)
+        out: np.ndarray = np.unpackbits(memo[key], axis=1, count=len(full)).astype(bool)
+        return out
+
+
+def _shown(view: View, pts: FloatArray, axes: Axes, cells: FloatArray, size: FloatArray,
+           rows: np.ndarray, todo: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs (``rows`` x ``todo``) where a target on the cell would show enough pixels
+    from the point, if nothing hid it: culled against the frustum, the rest counted."""
+    sure, maybe = cull(view, pts[rows], pick(axes, rows), cells[todo], size)
+    pi, ci = rows[maybe[0]], todo[maybe[1]]
+    big = shows_unhidden(view, pts, axes, cells, size, pi, ci)
+    return (np.concatenate([rows[sure[0]], pi[big]]),
+            np.concatenate([todo[sure[1]], ci[big]]))
+
+
+def _digest(*arrays: FloatArray) -> bytes:
+    """16 bytes standing for the arrays' values (a memo's key)."""
+    return hashlib.blake2b(b"".join(np.ascontiguousarray(a, dtype=float).tobytes()
+                                    for a in arrays), digest_size=16).digest()
 
 
 def _within(world: World, room: Room, pts: FloatArray) -> bool:
