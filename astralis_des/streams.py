@@ -9,8 +9,9 @@ from __future__ import annotations
 import numpy as np
 
 STREAMS = {"rooms": 1, "target": 2, "avatar": 3, "clutter": 4, "movers": 5, "sensing": 6,
-           "study": 7, "assignment": 8}  # study: a scenario's own draws (room values,
-# starts, segment); assignment: a round's (the random strategy)
+           "study": 7, "assignment": 8, "gnss": 9, "barometer": 10, "magnetometer": 11}
+# study: a scenario's own draws (room values, starts, segment); assignment: a round's (the
+# random strategy); gnss, barometer, magnetometer: a member's (keyed by its place in the team)
 
 
 def stream(seed: int, purpose: str, *keys: int) -> np.random.Generator:

@@ -194,6 +194,16 @@ CASES = [
          says=("greater than or equal to 0",)),
     Case("coordinate_1e308", replace("start: [90, 60, 0]", "start: [1e308, 60, 0]"),
          marker="start: [1e308", key="team[0].start[0]", says=("less than or equal to",)),
+    # issue 27: the pose sensors' keys and the site's geodetic origin
+    Case("latitude_beyond_90", append("site: {latitude: 95, longitude: 4}\n"),
+         marker="site: {latitude: 95", key="site.latitude", says=("less than or equal to 90",)),
+    Case("unknown_sensor", member(sensors="{gps: {}}"), marker=UAV2[:-1],
+         key="team[1].sensors.gps", says=("unknown key 'gps'",)),
+    Case("gnss_rate_zero", member(sensors="{gnss: {rate: 0}}"), marker=UAV2[:-1],
+         key="team[1].sensors.gnss.rate", says=("greater than 0",)),
+    Case("human_with_a_barometer", replace(OP1_START, OP1_START + ", sensors: {barometer: {}}"),
+         marker=OP1_START, key="team[3]", key_prefix=True,
+         says=("a human cannot carry a barometer",)),
 ]
 
 

@@ -108,6 +108,10 @@ class Client:
     def robot(self, robot: str) -> dict[str, Any]:
         return self.request("robot", robot=robot)
 
+    def reading(self, robot: str, sensor: str) -> dict[str, Any]:
+        """The latest reading of a robot's ``gnss``, ``barometer`` or ``magnetometer``."""
+        return self.request("reading", robot=robot, sensor=sensor)
+
     def queue(self, robot: str) -> dict[str, Any]:
         return self.request("queue", robot=robot)
 

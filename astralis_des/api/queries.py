@@ -172,6 +172,26 @@ def _robot(svc: Session, args: RobotArgs) -> dict[str, Any]:
     return robot_state(svc, svc.robot(args.robot))
 
 
+class ReadingArgs(Args):
+    robot: str
+    sensor: str = Field(description="gnss, barometer or magnetometer")
+
+
+@op("reading", ReadingArgs)
+def _reading(svc: Session, args: ReadingArgs) -> dict[str, Any]:
+    """The latest reading of a robot's GNSS, barometer or magnetometer (at or before now)."""
+    robot = svc.robot(args.robot)
+    sensors = svc.sim.pose_sensors
+    carried = sorted(name for rid, name in sensors.sensors if rid == robot.id)
+    if args.sensor not in carried:
+        raise ApiError("bad_request", f"{robot.id} carries no {args.sensor!r}; its pose "
+                       f"sensors: {', '.join(carried) or 'none'}")
+    sensors.update(float(svc.sim.env.now))
+    got = sensors.readings(robot.id, args.sensor)
+    return {"robot": robot.id, "sensor": args.sensor,
+            "reading": got.row(len(got) - 1) if len(got) else None}
+
+
 @op("queue", RobotArgs)
 def _queue(svc: Session, args: RobotArgs) -> dict[str, Any]:
     """A robot's running task and the tasks waiting, in the order they will run."""

@@ -239,6 +239,12 @@ class PhysicsCoSim:
         self.halt(robot)
         return self.env.timeout(seconds)
 
+    def body_pose(self, robot: Robot) -> tuple[FloatArray, FloatArray]:
+        """Where the robot is now, and world from body of its simulated body."""
+        _, quat = self.client.call("getBasePositionAndOrientation", self.drivers[robot.id].body)
+        return (self.drivers[robot.id].position(),
+                np.array(self.client.call("getMatrixFromQuaternion", quat)).reshape(3, 3))
+
     def halt(self, robot: Robot) -> None:
         if self.active.pop(robot.id, None) is not None:
             self.drivers[robot.id].freeze()

@@ -124,6 +124,9 @@ class Robot:
     trail_t: list[float] = field(default_factory=list)
     trail_p: list[FloatArray] = field(default_factory=list)
     plans: list[tuple[float, FloatArray]] = field(default_factory=list)  # (start, path) a leg
+    # each kinematic motion as it ran: (start, end, motion, heading at the end), for poses
+    # at any past time (pose sensors)
+    history: list[tuple[float, float, Motion, float]] = field(default_factory=list)
 
     def position(self, now: float) -> FloatArray:
         return self.motion.at(now) if self.motion is not None else self.pose
@@ -140,6 +143,7 @@ class Robot:
         times, pts = self.motion.vertices_until(now)
         if isinstance(self.motion, Motion):
             self.heading = self.motion.heading_at(now, self.heading)
+            self.history.append((self.motion.t0, now, self.motion, self.heading))
         self.trail_t.extend(times.tolist())
         self.trail_p.extend(pts)
         self.distance += self.motion.travelled(now)

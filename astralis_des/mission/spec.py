@@ -2,91 +2,36 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
-# Every number is finite: no .inf time limits, no .nan positions; and no coordinate beyond
-# what any site holds (1,000 km), so arithmetic on it cannot overflow.
-Finite = Annotated[float, Field(allow_inf_nan=False, ge=-1e6, le=1e6)]
-PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-MAX_SPEED = 100.0  # m/s: faster than any robot of a search team (a speed of 1e308 overflowed)
-NonNegativeFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-Vec3 = tuple[Finite, Finite, Finite]
-Kind = Literal["uav", "ugv", "human"]
-Unit = Annotated[float, Field(ge=0.0, le=1.0)]
-Sound = Literal["minimal", "moderate", "loud"]
-NAME_MAX = 200  # characters of a name that becomes a folder (file systems allow 255 bytes)
-
-
-class Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class CameraSpec(Strict):
-    """A pinhole camera: RGB, depth and segmentation (physics), or its frustum (kinematic).
-
-    Unset geometry comes from the robot's kind (``astralis_des.kinds``)."""
-
-    width: int = Field(320, gt=0, le=4096, description="pixels")
-    height: int = Field(240, gt=0, le=4096, description="pixels")
-    fov_deg: float | None = Field(None, gt=0, lt=180, description="vertical field of view")
-    range: PositiveFloat | None = Field(None, description="m: farther is not detected")
-    pitch_deg: float | None = Field(None, ge=-90, le=90,
-                                    description="0 forward, 90 straight down")
-    min_pixels: int = Field(40, ge=1, description="target pixels a detection needs (physics)")
-    rate: PositiveFloat = Field(
-        4.0, le=60, description="looks per s while searching (physics): a frame is rendered "
-        "when the target's box may be in view, else the look costs a frustum test")
-    record_rate: NonNegativeFloat = Field(
-        0.5, le=10, description="frames per s kept for the recording, rendered at half "
-        "resolution (physics); 0: only the frame of a detection")
-    position_noise: NonNegativeFloat = Field(
-        0.03, description="kinematic fidelity: the estimate's error per axis, a share of the "
-        "distance (physics estimates from the depth pixels)")
-
-
-class LidarSpec(Strict):
-    """A 2-D lidar in the robot's horizontal plane (physics fidelity)."""
-
-    beams: int = Field(360, ge=1, le=4096)
-    range: PositiveFloat = 30.0
-    rate: PositiveFloat = Field(10.0, le=60, description="scans per s while moving")
-    noise_std: NonNegativeFloat = Field(0.01, description="m, range noise")
-    record_rate: NonNegativeFloat = Field(1.0, le=60, description="scans per s kept for the "
-                                          "recording")
-
-
-class ImuSpec(Strict):
-    """An IMU: specific force and angular rate, with noise and constant biases (physics)."""
-
-    rate: PositiveFloat = Field(20.0, description="readings per s while moving, rounded to "
-                                "whole controller ticks; at most the physics control_rate")
-    accel_noise: NonNegativeFloat = 0.02
-    gyro_noise: NonNegativeFloat = 0.002
-    accel_bias: Vec3 = (0.0, 0.0, 0.0)
-    gyro_bias: Vec3 = (0.0, 0.0, 0.0)
-
-
-class SensorsSpec(Strict):
-    """What a robot carries. A member without ``sensors`` gets its kind's set
-    (UAV: camera and IMU; UGV: camera, lidar and IMU; human: camera); one that names
-    sensors gets a camera unless ``camera: null``, and only the lidar and IMU it names."""
-
-    camera: CameraSpec | None = Field(default_factory=CameraSpec)
-    lidar: LidarSpec | None = None
-    imu: ImuSpec | None = None
-    plugins: dict[str, dict[str, Any]] = Field(
-        default_factory=dict, description="sensors added by name (registered in "
-        "astralis_des.plugins.SENSORS), each with its parameters: {name: {param: value}}")
-
-
-SENSORS = ("camera", "lidar", "imu")
-# What each kind can carry: the human operator has eyes (a camera model) and nothing else.
-CARRIES: dict[str, tuple[str, ...]] = {
-    "uav": SENSORS, "ugv": SENSORS, "human": ("camera",),
-}
-_DEFAULT_SPECS = {"camera": CameraSpec(), "lidar": LidarSpec(), "imu": ImuSpec()}
+from astralis_des.mission.sensor_spec import (  # noqa: F401  (re-exported)
+    _DEFAULT_SPECS,
+    CARRIES,
+    POSE_SENSORS,
+    SENSORS,
+    BarometerSpec,
+    CameraSpec,
+    GnssSpec,
+    ImuSpec,
+    LidarSpec,
+    MagnetometerSpec,
+    SensorsSpec,
+    SiteSpec,
+)
+from astralis_des.mission.types import (  # noqa: F401  (re-exported)
+    MAX_SPEED,
+    NAME_MAX,
+    Finite,
+    Kind,
+    NonNegativeFloat,
+    PositiveFloat,
+    Sound,
+    Strict,
+    Unit,
+    Vec3,
+)
 
 
 class MemberSpec(Strict):
@@ -118,7 +63,8 @@ class MemberSpec(Strict):
         from astralis_des.kinds import KIND_DEFAULTS
 
         carried = KIND_DEFAULTS[self.kind].sensors
-        return SensorsSpec(**{n: _DEFAULT_SPECS[n] if n in carried else None for n in SENSORS})
+        return SensorsSpec(**{n: _DEFAULT_SPECS.get(n) if n in carried else None
+                              for n in SENSORS})
 
 
 class RoomProps(Strict):
@@ -356,6 +302,7 @@ class MissionSpec(Strict):
     planning: PlanningSpec = Field(default_factory=PlanningSpec)
     physics: PhysicsSpec = Field(default_factory=PhysicsSpec)
     outputs: OutputsSpec = Field(default_factory=OutputsSpec)
+    site: SiteSpec = Field(default_factory=SiteSpec)
 
     @field_validator("team")
     @classmethod

@@ -27,6 +27,7 @@ from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.mission.draws import draw_rooms, draw_target
 from astralis_des.mission.loader import Mission
 from astralis_des.mission.spec import MemberSpec
+from astralis_des.navsensors import BodySamples, PoseSensors, motion_poses
 from astralis_des.planning.navigator import Navigator
 from astralis_des.plugins import SENSORS
 from astralis_des.sensing import GeometricSensor, Sighting
@@ -95,6 +96,13 @@ class Simulation:
             m.id: {name: SENSORS.get(name)(self, self.robots[m.id], params)
                    for name, params in m.sensor_set.plugins.items()}
             for m in spec.team if m.sensor_set.plugins}
+        # GNSS, barometers, magnetometers: read from the pose, in either fidelity (a
+        # simulated body's is sampled at their reading times)
+        self.pose_sensors = PoseSensors.of(self, motion_poses)
+        self._bodies: BodySamples | None = None
+        if hasattr(self.cosim, "body_pose") and self.pose_sensors.sensors:
+            self._bodies = BodySamples(self.env, self.cosim.body_pose)
+            self.pose_sensors.poses = self._bodies.poses
 
     # -- set-up ----------------------------------------------------------------------------
     def _not_placed(self, room: str, kind: str, reason: str) -> None:
@@ -305,6 +313,8 @@ class Simulation:
             ends.append(self._timeline)
         for event in spec.timeline:
             self.env.process(scheduled(self, event))
+        if self._bodies is not None:
+            self._bodies.start(self.pose_sensors)
         for mine in self.sensors.values():
             for sensor in mine.values():
                 self.env.process(sensor.run())
@@ -350,6 +360,7 @@ class Simulation:
             self.cosim.halt(robot)
             if robot.id in self._started:  # still at work when the mission ended
                 robot.busy_time += self.env.now - self._started.pop(robot.id)[1]
+        self.pose_sensors.update(float(self.env.now))  # while the bodies are there to read
         self.cosim.close()
         self.log.emit("mission_end", outcome=outcome)
         result = build_result(self, outcome, time.perf_counter() - self._wall0)

@@ -12,7 +12,7 @@ from astralis_des.sinks import paths
 
 def blueprint(finder: str | None, cameras: list[str],
               focus: tuple[tuple[float, float, float], tuple[float, float, float]],
-              hidden: list[str] | None = None) -> Any:
+              hidden: list[str] | None = None, sensed: list[str] | None = None) -> Any:
     """The layout; the 3-D view looks down from the south at the box ``focus`` (the rooms
     searched), steep enough to see into rooms over their walls, without the storeys and roofs
     ``hidden`` (``A/3``: those above the ones searched; tick them on to see them). A camera
@@ -42,13 +42,28 @@ def blueprint(finder: str | None, cameras: list[str],
                                      name="coverage of each search (share)"),
                   rrb.TimeSeriesView(origin=paths.mission_metric("distance"),
                                      name="distance travelled (m)"))]
+    if sensed:  # robots with GNSS, barometers, magnetometers: their series and a map
+        def series(what: str) -> list[str]:
+            return [f"+ /robots/{rid}/{what}" for rid in sensed]
+
+        right.append(rrb.Tabs(
+            rrb.TimeSeriesView(origin="/robots", name="altitude (barometer, m)",
+                               contents=series("barometer/altitude")),
+            rrb.TimeSeriesView(origin="/robots", name="GNSS satellites seen",
+                               contents=series("gnss/satellites")),
+            rrb.TimeSeriesView(origin="/robots", name="heading (magnetometer, deg)",
+                               contents=series("magnetometer/heading")),
+            rrb.MapView(origin="/robots", name="GNSS fixes on a map",
+                        contents=series("gnss/geo"))))
     scene = rrb.Spatial3DView(
         origin="/", name="mission", eye_controls=eye,
         contents=["+ /world/**", "- /world/occupancy/**",
                   *[f"- /world/{part}/**" for part in hidden or []], "+ /robots/**",
                   "+ /mission/detections/**",
                   "- /robots/*/camera/**", "- /robots/*/imu/**", "- /robots/*/state/**",
-                  "- /robots/*/task/**"])
+                  "- /robots/*/task/**",
+                  *[f"- /robots/{rid}/{part}/**" for rid in sensed or []
+                    for part in ("barometer", "magnetometer", "gnss/geo")]])
     lanes = rrb.StateTimelineView(origin="/robots", name="task lanes")
     return rrb.Blueprint(
         rrb.Horizontal(rrb.Vertical(scene, lanes, row_shares=[3, 1]),

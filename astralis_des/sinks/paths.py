@@ -65,6 +65,11 @@ def robot_imu(robot_id: str, what: str) -> str:
     return f"robots/{robot_id}/imu/{what}"
 
 
+def robot_sensor(robot_id: str, sensor: str, what: str = "") -> str:
+    """A pose sensor's entity (``gnss``, ``barometer``, ``magnetometer``), or a series of it."""
+    return f"robots/{robot_id}/{sensor}" + (f"/{what}" if what else "")
+
+
 MISSION_DETECTIONS = "mission/detections"
 
 

@@ -14,7 +14,7 @@ from astralis_des.sinks import paths
 from astralis_des.sinks.blueprint import blueprint
 from astralis_des.sinks.looks import TABLE_II_COLORS, by_place, log_body, robot_colors
 from astralis_des.sinks.replay import log_lanes, log_metrics, log_rounds, metrics, task_lanes
-from astralis_des.sinks.sensor_log import log_detections, log_sensors
+from astralis_des.sinks.sensor_log import log_detections, log_pose_sensors, log_sensors
 from astralis_des.world.clutter import Placed
 from astralis_des.world.model import BLOCK, World
 
@@ -136,6 +136,7 @@ class RerunRecorder:
         perception = getattr(self.sim.cosim, "perception", None)
         if perception is not None:
             log_sensors(rr, rec, perception)
+        log_pose_sensors(rr, rec, self.sim.pose_sensors)
         log_detections(rr, rec, self.sim.log.records)
         self._send_new()
         palette = robot_colors(list(self.sim.robots))
@@ -197,8 +198,8 @@ class RerunRecorder:
                   max(b.hi[2] for b in rooms)))
         shown = [sim.world.rooms[result.target["room"]]] if result.found_by else \
             [min(searched, key=lambda r: r.floor)]  # up to where it was found, or began
-        rec.send_blueprint(blueprint(result.found_by, cameras, focus,
-                                     above(sim.world, shown)))
+        rec.send_blueprint(blueprint(result.found_by, cameras, focus, above(sim.world, shown),
+                                     sorted({rid for rid, _ in sim.pose_sensors.sensors})))
 
 
 def above(world: World, shown: Sequence[Any]) -> list[str]:

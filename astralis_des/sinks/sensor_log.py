@@ -15,6 +15,7 @@ from astralis_des.kernel.events import Record
 from astralis_des.sinks import paths
 
 if TYPE_CHECKING:
+    from astralis_des.navsensors import PoseSensors
     from astralis_des.physics.perception import KeptFrame, KeptScan, Perception
 
 Kept = TypeVar("Kept", "KeptFrame", "KeptScan")
@@ -84,3 +85,37 @@ def log_detections(rr: Any, rec: Any, records: list[Record]) -> None:
             [estimate], radii=0.25, colors=[(255, 40, 40)],
             labels=[f"{hit['robot']} saw the target (error {hit['error']:.2f} m)"]),
             rr.Arrows3D(origins=[origin], vectors=[estimate - origin], colors=[(255, 40, 40)]))
+
+
+def log_pose_sensors(rr: Any, rec: Any, sensors: PoseSensors) -> None:
+    """The GNSS fixes (positions in the site's frame at ``/robots/<id>/gnss``, latitude and
+    longitude at ``.../gnss/geo`` for a map, the satellites seen and the open sky), the
+    barometers' pressure and altitude, the magnetometers' field and heading, on the time
+    line."""
+    for rid, name in sensors.sensors:
+        got = sensors.readings(rid, name)
+        if not len(got):
+            continue
+        index = [rr.TimeColumn(paths.TIMELINE, duration=got.t)]
+        c = got.columns
+        if name == "gnss":
+            entity = paths.robot_sensor(rid, name)
+            rec.send_columns(entity, indexes=index,
+                             columns=rr.Points3D.columns(positions=c["position"]))
+            rec.log(entity, rr.Points3D.from_fields(radii=0.25, colors=[(40, 200, 120)]),
+                    static=True)
+            rec.send_columns(f"{entity}/geo", indexes=index, columns=rr.GeoPoints.columns(
+                positions=np.column_stack([c["latitude"], c["longitude"]])))
+        scalars = {"gnss": ("satellites", "open_sky"), "barometer": ("pressure", "altitude"),
+                   "magnetometer": ("heading",)}[name]
+        for what in scalars:
+            rec.send_columns(paths.robot_sensor(rid, name, what), indexes=index,
+                             columns=rr.Scalars.columns(
+                                 scalars=np.asarray(c[what], dtype=float)))
+        if name == "magnetometer":
+            field = np.asarray(c["field"], dtype=float)
+            rec.send_columns(paths.robot_sensor(rid, name, "field"), indexes=index,
+                             columns=rr.Scalars.columns(scalars=field.ravel()).partition(
+                                 [3] * len(field)))
+            rec.log(paths.robot_sensor(rid, name, "field"),
+                    rr.SeriesLines(names=["forward", "left", "up"]), static=True)

@@ -1,0 +1,23 @@
+"""The mission schema's building blocks: strict models and checked numbers."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+# Every number is finite: no .inf time limits, no .nan positions; and no coordinate beyond
+# what any site holds (1,000 km), so arithmetic on it cannot overflow.
+Finite = Annotated[float, Field(allow_inf_nan=False, ge=-1e6, le=1e6)]
+PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+MAX_SPEED = 100.0  # m/s: faster than any robot of a search team (a speed of 1e308 overflowed)
+NonNegativeFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Vec3 = tuple[Finite, Finite, Finite]
+Kind = Literal["uav", "ugv", "human"]
+Unit = Annotated[float, Field(ge=0.0, le=1.0)]
+Sound = Literal["minimal", "moderate", "loud"]
+NAME_MAX = 200  # characters of a name that becomes a folder (file systems allow 255 bytes)
+
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
