@@ -39,7 +39,7 @@ from astralis_des.world.model import World
 if TYPE_CHECKING:
     from astralis_des.kernel.contracts import Host
 
-SKY_CELL = 0.5  # m: the open share of the sky is sampled on this grid
+SKY_CELL = 1.0  # m: the open share of the sky is sampled on this grid
 SKY_REACH = 60.0  # m: a ray to the sky clear this far is clear (over any building here)
 ELEVATIONS = (25.0, 45.0, 65.0)  # degrees of the rays to the sky (mask: 15)
 AZIMUTHS = 8  # rays per elevation, and one straight up
