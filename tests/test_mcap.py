@@ -168,3 +168,29 @@ def test_export_refuses_a_run_its_mission_does_not_reproduce(
     assert err.startswith("error: ") and "\n" not in err
     assert "events.jsonl:6:" in err and "does not reproduce this run" in err
     assert not (out / "run.mcap").exists()
+
+
+def test_pose_sensors_come_as_navsatfix_fluidpressure_and_magneticfield(
+        tmp_path: Path) -> None:
+    """missions/sensor_suite.yaml with --mcap: the UAV's GNSS fixes as NavSatFix (a fix in
+    the street near the site's origin, STATUS_NO_FIX with NaN once under the slab), its
+    barometer as FluidPressure (Pa, about the ISA pressure 130-132 m up) and its
+    magnetometer as MagneticField (tesla, the site's 51.5 microtesla)."""
+    out = tmp_path / "suite"
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main(["run", str(ROOT / "missions" / "sensor_suite.yaml"), "--out", str(out),
+                     "--mcap", "--no-recording"]) == 0
+    types, messages = _read(out / "run.mcap")
+    assert types["/uav1/gnss/fix"] == "sensor_msgs/msg/NavSatFix"
+    assert types["/uav1/barometer"] == "sensor_msgs/msg/FluidPressure"
+    assert types["/uav1/magnetometer"] == "sensor_msgs/msg/MagneticField"
+    fixes = [m for _, m in messages["/uav1/gnss/fix"]]
+    assert fixes[0].status.status == 0 and fixes[0].latitude == pytest.approx(44.0582, abs=1e-3)
+    assert fixes[0].position_covariance[0] == pytest.approx(1.5**2)
+    lost = [f for f in fixes if f.status.status == -1]
+    assert lost and all(np.isnan(f.latitude) for f in lost)
+    pressures = np.array([m.fluid_pressure for _, m in messages["/uav1/barometer"]])
+    assert pressures.min() > 99_500 and pressures.max() < 99_800  # 130-132 m up
+    field = np.array([[m.magnetic_field.x, m.magnetic_field.y, m.magnetic_field.z]
+                      for _, m in messages["/uav1/magnetometer"]])
+    assert np.linalg.norm(field, axis=1).mean() == pytest.approx(51.5e-6, rel=0.02)

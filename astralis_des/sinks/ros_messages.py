@@ -130,8 +130,10 @@ def planned_paths(ty: Types, sim: Simulation) -> Iterator[Stamped]:
 
 
 def sensors(ty: Types, sim: Simulation) -> Iterator[Stamped]:
-    """What the physics fidelity's sensors kept: camera frames (Image and CameraInfo, with
+    """The pose sensors' readings (NavSatFix, FluidPressure, MagneticField; both fidelities)
+    and what the physics fidelity's sensors kept: camera frames (Image and CameraInfo, with
     the camera's TF), lidar scans (LaserScan) and IMU readings (Imu)."""
+    yield from pose_sensors(ty, sim)
     perception = getattr(sim.cosim, "perception", None)
     if perception is None:
         return
@@ -207,3 +209,44 @@ def _scan(ty: Types, sim: Simulation, scan: Any, beams: int, reach: float) -> It
                angle_max=math.pi - step, angle_increment=step, time_increment=0.0,
                scan_time=0.0, range_min=0.05, range_max=float(reach), ranges=ranges,
                intensities=np.zeros(0, dtype=np.float32)))
+
+
+NO_FIX, FIX = -1, 0  # sensor_msgs/NavSatStatus: STATUS_NO_FIX, STATUS_FIX
+SERVICE_GPS, COVARIANCE_DIAGONAL_KNOWN = 1, 2
+
+
+def pose_sensors(ty: Types, sim: Simulation) -> Iterator[Stamped]:
+    """Each GNSS fix as a NavSatFix (no fix: NaN with STATUS_NO_FIX; the covariance its noise
+    was drawn with), each barometer reading as a FluidPressure (Pa) and each magnetometer
+    reading as a MagneticField (tesla, in ``ROBOT/base_link``: x forward, y left, z up)."""
+    specs = {m.id: m.sensor_set for m in sim.mission.spec.team}
+    for rid, name in sim.pose_sensors.sensors:
+        got = sim.pose_sensors.readings(rid, name)
+        c, frame = got.columns, f"{rid}/base_link"
+        for i, t in enumerate(got.t.tolist()):
+            if name == "gnss":
+                h, v = float(c["horizontal_std"][i]), float(c["vertical_std"][i])
+                fixed = math.isfinite(h)
+                yield (t, f"/{rid}/gnss/fix", "sensor_msgs/msg/NavSatFix",
+                       ty.sensor_msgs__NavSatFix(
+                           header=header(ty, t, frame), status=ty.sensor_msgs__NavSatStatus(
+                               status=FIX if fixed else NO_FIX, service=SERVICE_GPS),
+                           latitude=float(c["latitude"][i]),
+                           longitude=float(c["longitude"][i]),
+                           altitude=float(c["altitude"][i]),
+                           position_covariance=np.diag([h * h, h * h, v * v]).ravel()
+                           if fixed else np.full(9, -1.0),
+                           position_covariance_type=COVARIANCE_DIAGONAL_KNOWN if fixed else 0))
+            elif name == "barometer":
+                noise = specs[rid].barometer.noise  # type: ignore[union-attr]
+                yield (t, f"/{rid}/barometer", "sensor_msgs/msg/FluidPressure",
+                       ty.sensor_msgs__FluidPressure(
+                           header=header(ty, t, frame), fluid_pressure=float(c["pressure"][i]),
+                           variance=float(noise * noise)))
+            else:
+                sigma = specs[rid].magnetometer.noise * 1e-6  # type: ignore[union-attr]
+                yield (t, f"/{rid}/magnetometer", "sensor_msgs/msg/MagneticField",
+                       ty.sensor_msgs__MagneticField(
+                           header=header(ty, t, frame),
+                           magnetic_field=vector(ty, np.asarray(c["field"][i]) * 1e-6),
+                           magnetic_field_covariance=np.diag([sigma * sigma] * 3).ravel()))
