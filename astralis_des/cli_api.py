@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import importlib
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from astralis_des.api.protocol import read_pace
@@ -82,7 +83,7 @@ def add_api_parsers(sub: Any, add_mission_options: Callable[[Any], None]) -> Non
     _add_clock_options(chat)
     add_mission_options(chat)
     teleop = sub.add_parser("teleop", help="walk a robot (the human operator) with the arrow "
-                            "or WASD keys")
+                            "or WASD keys, or drive any robot with a game controller")
     teleop.add_argument("robot", help="robot id, e.g. op1")
     teleop.add_argument("--connect", metavar="ADDR", default="tcp://127.0.0.1:5555",
                         help="the server (default tcp://127.0.0.1:5555)")
@@ -91,3 +92,7 @@ def add_api_parsers(sub: Any, add_mission_options: Callable[[Any], None]) -> Non
     teleop.add_argument("--step", type=float, default=0.5, metavar="M",
                         help="metres a key press moves (default 0.5)")
     teleop.add_argument("--timeout", type=float, default=2.0, help="s to wait for a reply")
+    teleop.add_argument("--gamepad", action="store_true", help="drive it with a game "
+                        "controller (the gamepad extra: SDL) instead of the keys")
+    teleop.add_argument("--mapping", type=Path, metavar="FILE", help="the controller's "
+                        "mapping (default astralis_des/data/gamepad.yaml)")

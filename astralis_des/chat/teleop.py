@@ -14,7 +14,7 @@ import select
 import sys
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import AbstractContextManager, contextmanager, nullcontext
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from rich.console import Console
 from rich.text import Text
@@ -138,6 +138,8 @@ def teleop_command(args: argparse.Namespace) -> int:
         if args.robot not in team:
             raise InputError(f"no robot '{args.robot}'; {suggest(args.robot, team)}")
         console = Console(highlight=False)
+        if args.gamepad:
+            return _gamepad(args, client, console, team[args.robot]["type"])
         fd = sys.stdin.fileno()
         terminal = os.isatty(fd)
         console.print(Text(f"driving {args.robot} ({team[args.robot]['type']}) at "
@@ -154,6 +156,31 @@ def teleop_command(args: argparse.Namespace) -> int:
         finally:
             status.close()
     return 0
+
+
+def _gamepad(args: argparse.Namespace, client: Client, console: Console, kind: str) -> int:
+    from astralis_des.chat.gamepad import Gamepad, drive_pad, load_mapping, open_pad
+
+    mapping = load_mapping(args.mapping)
+    pad = Gamepad(client, args.robot, open_pad(), mapping)
+    session = Teleop(client, args.robot, mapping.step)
+    console.print(Text(f"driving {args.robot} ({kind}) at {args.connect} with the game "
+                       f"controller: the left stick steps up to {mapping.step:g} m; "
+                       + ", ".join(f"button {n}: {_does(b)}"
+                                   for n, b in sorted(mapping.buttons.items()))),
+                  soft_wrap=True)
+    status = StatusLine(console, in_place=console.is_terminal)
+    try:
+        drive_pad(pad, status.show, session.line)
+    except KeyboardInterrupt:
+        return EXIT_INTERRUPTED
+    finally:
+        status.close()
+    return 0
+
+
+def _does(button: Any) -> str:
+    return "quit" if button.quit else "stop" if button.stop else str(button.action)
 
 
 def _keys_mode(fd: int, terminal: bool) -> AbstractContextManager[None]:
