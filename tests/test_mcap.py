@@ -172,7 +172,8 @@ def test_export_refuses_a_run_its_mission_does_not_reproduce(
 
 def test_pose_sensors_come_as_navsatfix_fluidpressure_and_magneticfield(
         tmp_path: Path) -> None:
-    """missions/sensor_suite.yaml with --mcap: the UAV's GNSS fixes as NavSatFix (a fix in
+    """missions/sensor_suite.yaml with --mcap: its kept 3-D lidar sweeps as PointCloud2
+    (x, y, z and the id of the body hit); the UAV's GNSS fixes as NavSatFix (a fix in
     the street near the site's origin, STATUS_NO_FIX with NaN once under the slab), its
     barometer as FluidPressure (Pa, about the ISA pressure 130-132 m up) and its
     magnetometer as MagneticField (tesla, the site's 51.5 microtesla)."""
@@ -194,3 +195,9 @@ def test_pose_sensors_come_as_navsatfix_fluidpressure_and_magneticfield(
     field = np.array([[m.magnetic_field.x, m.magnetic_field.y, m.magnetic_field.z]
                       for _, m in messages["/uav1/magnetometer"]])
     assert np.linalg.norm(field, axis=1).mean() == pytest.approx(51.5e-6, rel=0.02)
+    assert types["/uav1/lidar3d/points"] == "sensor_msgs/msg/PointCloud2"
+    cloud = messages["/uav1/lidar3d/points"][-1][1]
+    assert [f.name for f in cloud.fields] == ["x", "y", "z", "id"] and cloud.point_step == 16
+    rows = np.frombuffer(bytes(cloud.data), dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"),
+                                                   ("id", "<i4")])
+    assert len(rows) == cloud.width > 5000 and (rows["id"] >= 0).all()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from astralis_des.mission.types import Finite, NonNegativeFloat, PositiveFloat, Strict, Vec3
 
@@ -41,6 +41,29 @@ class LidarSpec(Strict):
     noise_std: NonNegativeFloat = Field(0.01, description="m, range noise")
     record_rate: NonNegativeFloat = Field(1.0, le=60, description="scans per s kept for the "
                                           "recording")
+
+
+class Lidar3dSpec(Strict):
+    """A spinning multi-channel lidar (physics fidelity), levelled, turning with the body's
+    heading; the defaults are a 16-channel unit's."""
+
+    channels: int = Field(16, ge=1, le=128)
+    vertical_fov: tuple[float, float] = Field(
+        (-15.0, 15.0), description="degrees: the lowest and the highest channel's elevation")
+    resolution: float = Field(0.2, ge=0.05, le=10.0, description="degrees between azimuths")
+    range: PositiveFloat = Field(100.0, le=1000.0, description="m")
+    rate: PositiveFloat = Field(10.0, le=20, description="sweeps per s while moving")
+    noise_std: NonNegativeFloat = Field(0.01, le=10.0, description="m, range noise")
+    record_rate: NonNegativeFloat = Field(1.0, le=20, description="sweeps per s kept for "
+                                          "the recording")
+
+    @model_validator(mode="after")
+    def _fov(self) -> Lidar3dSpec:
+        low, high = self.vertical_fov
+        if not -90.0 <= low < high <= 90.0:
+            raise ValueError(f"vertical_fov must be [low, high] with -90 <= low < high <= 90 "
+                             f"degrees (got [{low:g}, {high:g}])")
+        return self
 
 
 class ImuSpec(Strict):
@@ -111,6 +134,7 @@ class SensorsSpec(Strict):
 
     camera: CameraSpec | None = Field(default_factory=CameraSpec)
     lidar: LidarSpec | None = None
+    lidar3d: Lidar3dSpec | None = None
     imu: ImuSpec | None = None
     gnss: GnssSpec | None = None
     barometer: BarometerSpec | None = None
@@ -120,7 +144,7 @@ class SensorsSpec(Strict):
         "astralis_des.plugins.SENSORS), each with its parameters: {name: {param: value}}")
 
 
-SENSORS = ("camera", "lidar", "imu", "gnss", "barometer", "magnetometer")
+SENSORS = ("camera", "lidar", "lidar3d", "imu", "gnss", "barometer", "magnetometer")
 POSE_SENSORS = ("gnss", "barometer", "magnetometer")  # read the pose alone: both fidelities
 # What each kind can carry: the human operator has eyes (a camera model) and nothing else.
 CARRIES: dict[str, tuple[str, ...]] = {

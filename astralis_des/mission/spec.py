@@ -15,6 +15,7 @@ from astralis_des.mission.sensor_spec import (  # noqa: F401  (re-exported)
     CameraSpec,
     GnssSpec,
     ImuSpec,
+    Lidar3dSpec,
     LidarSpec,
     MagnetometerSpec,
     SensorsSpec,

@@ -31,7 +31,8 @@ from numpy.typing import NDArray
 
 from astralis_des.detection import predict_pixels
 from astralis_des.kernel.robot import Robot
-from astralis_des.mission.spec import CameraSpec, ImuSpec, LidarSpec
+from astralis_des.mission.spec import CameraSpec, ImuSpec, Lidar3dSpec, LidarSpec
+from astralis_des.physics.lidar3d import Lidar3D
 from astralis_des.physics.sensors import Camera, Frame, Imu, ImuReading, Intrinsics, Lidar2D
 from astralis_des.sensing import Sighting, in_frame
 from astralis_des.streams import stream
@@ -92,6 +93,14 @@ class KeptScan:
 
 
 @dataclass
+class KeptCloud:
+    robot: str
+    time: float
+    points: FloatArray  # (M, 3): the returns only
+    ids: NDArray[np.int32]  # (M,): the body each return hit (its segmentation id)
+
+
+@dataclass
 class ImuTrace:
     times: list[float] = field(default_factory=list)
     readings: list[ImuReading] = field(default_factory=list)
@@ -124,6 +133,8 @@ class Perception:
         self.imu_traces: dict[str, ImuTrace] = {}
         self.eyes: dict[str, Eyes] = {}
         self.lidars: dict[str, tuple[Lidar2D, LidarSpec]] = {}
+        self.lidars3d: dict[str, tuple[Lidar3D, Lidar3dSpec]] = {}
+        self.clouds: list[KeptCloud] = []
         self.imus: dict[str, tuple[Imu, ImuSpec]] = {}
         seed = sim.mission.spec.seed
         for index, member in enumerate(sim.mission.spec.team):
@@ -137,6 +148,14 @@ class Perception:
                     cosim.client, body, _mount(cosim, member.id), spec.beams, spec.range,
                     noise_std=spec.noise_std, rng=stream(seed, "sensing", 1, index),
                     start_offset=LIDAR_OFFSET.get(member.kind, 0.5)), spec)
+            if sensors.lidar3d is not None:
+                s3 = sensors.lidar3d
+                self.lidars3d[member.id] = (Lidar3D(
+                    cosim.client, body, channels=s3.channels, vertical_fov=s3.vertical_fov,
+                    resolution=s3.resolution, range_max=s3.range, noise_std=s3.noise_std,
+                    rng=stream(seed, "sensing", 3, index),
+                    start_offset=LIDAR_OFFSET.get(member.kind, 0.5),
+                    mount=tuple(_mount(cosim, member.id))), s3)
             if sensors.imu is not None:
                 spec_i = sensors.imu
                 self.imus[member.id] = (Imu(
@@ -244,6 +263,23 @@ class Perception:
             self.env.process(self._scan(robot, done))
         if robot.id in self.imus:
             self.env.process(self._read(robot, done))
+        if robot.id in self.lidars3d:
+            self.env.process(self._sweep(robot, done))
+
+    def _sweep(self, robot: Robot, done: simpy.Event) -> Generator[simpy.Event, Any, None]:
+        """The 3-D lidar at its rate while the robot moves; every so often a sweep kept."""
+        lidar, spec = self.lidars3d[robot.id]
+        keep_every = max(1, round(spec.rate / spec.record_rate)) if spec.record_rate else 0
+        count = 0
+        while not done.triggered:
+            with self.clock.timed("lidar3d"):
+                scan = lidar.scan(self.env.now)
+            if keep_every and count % keep_every == 0:
+                hit = np.isfinite(scan.ranges)
+                self.clouds.append(KeptCloud(robot.id, self.env.now, scan.points[hit],
+                                             scan.hit_ids[hit]))
+            count += 1
+            yield self.env.timeout(1.0 / spec.rate) | done
 
     def _scan(self, robot: Robot, done: simpy.Event) -> Generator[simpy.Event, Any, None]:
         lidar, spec = self.lidars[robot.id]

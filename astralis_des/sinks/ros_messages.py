@@ -146,6 +146,8 @@ def sensors(ty: Types, sim: Simulation) -> Iterator[Stamped]:
     for scan in perception.scans:
         yield from _scan(ty, sim, scan, beams.get(scan.robot, 360),
                          ranges.get(scan.robot, 30.0))
+    for cloud in perception.clouds:
+        yield _cloud(ty, cloud)
     for rid, trace in perception.imu_traces.items():
         for t, reading in zip(trace.times, trace.readings, strict=True):
             yield (t, f"/{rid}/imu", "sensor_msgs/msg/Imu", ty.sensor_msgs__Imu(
@@ -250,3 +252,23 @@ def pose_sensors(ty: Types, sim: Simulation) -> Iterator[Stamped]:
                            header=header(ty, t, frame),
                            magnetic_field=vector(ty, np.asarray(c["field"][i]) * 1e-6),
                            magnetic_field_covariance=np.diag([sigma * sigma] * 3).ravel()))
+
+
+INT32, FLOAT32 = 5, 7  # sensor_msgs/PointField datatypes
+
+
+def _cloud(ty: Types, cloud: Any) -> Stamped:
+    """A kept 3-D lidar sweep as a PointCloud2 in ``map``: x, y, z (float32) and the id of
+    the body each return hit (int32, its segmentation id)."""
+    n = len(cloud.points)
+    rows = np.zeros(n, dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("id", "<i4")])
+    rows["x"], rows["y"], rows["z"] = (cloud.points[:, k] for k in range(3))
+    rows["id"] = cloud.ids
+    fields = [ty.sensor_msgs__PointField(name=name, offset=4 * k, datatype=kind, count=1)
+              for k, (name, kind) in enumerate((("x", FLOAT32), ("y", FLOAT32),
+                                                ("z", FLOAT32), ("id", INT32)))]
+    return (cloud.time, f"/{cloud.robot}/lidar3d/points", "sensor_msgs/msg/PointCloud2",
+            ty.sensor_msgs__PointCloud2(
+                header=header(ty, cloud.time, "map"), height=1, width=n, fields=fields,
+                is_bigendian=False, point_step=16, row_step=16 * n,
+                data=rows.view(np.uint8).ravel(), is_dense=True))

@@ -16,9 +16,15 @@ from astralis_des.sinks import paths
 
 if TYPE_CHECKING:
     from astralis_des.navsensors import PoseSensors
-    from astralis_des.physics.perception import KeptFrame, KeptScan, Perception
+    from astralis_des.physics.perception import KeptCloud, KeptFrame, KeptScan, Perception
 
-Kept = TypeVar("Kept", "KeptFrame", "KeptScan")
+Kept = TypeVar("Kept", "KeptFrame", "KeptScan", "KeptCloud")
+
+
+def by_height(z: np.ndarray, top: float = 12.0) -> np.ndarray:
+    """RGB a point by its height: blue on the ground, through green, to yellow ``top`` up."""
+    h = np.clip(np.asarray(z, dtype=float) / top, 0.0, 1.0)
+    return np.column_stack([60 + 190 * h, 90 + 150 * np.sqrt(h), 200 - 170 * h]).astype(np.uint8)
 
 
 def _by_robot(items: Sequence[Kept]) -> dict[str, list[Kept]]:
@@ -40,6 +46,15 @@ def log_sensors(rr: Any, rec: Any, perception: Perception) -> None:
                              [len(s.points) for s in kept]))
         rec.log(paths.robot_lidar(rid), rr.Points3D.from_fields(radii=0.03,
                                                                 colors=[(255, 90, 90)]),
+                static=True)
+    for rid, clouds in _by_robot(perception.clouds).items():
+        points = np.vstack([c.points for c in clouds])
+        rec.send_columns(paths.robot_sensor(rid, "lidar3d"),
+                         indexes=[rr.TimeColumn(paths.TIMELINE, duration=[c.time for c in clouds])],
+                         columns=rr.Points3D.columns(positions=points,
+                                                     colors=by_height(points[:, 2])).partition(
+                             [len(c.points) for c in clouds]))
+        rec.log(paths.robot_sensor(rid, "lidar3d"), rr.Points3D.from_fields(radii=0.02),
                 static=True)
     for rid, trace in perception.imu_traces.items():
         if not trace.times:
