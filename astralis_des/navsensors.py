@@ -245,17 +245,25 @@ Poses = Callable[[Robot, FloatArray], tuple[FloatArray, FloatArray]]
 MODELS: dict[str, Callable[..., Any]] = {}  # sensor name -> model(host, member, index)
 
 
+def site_origin(host: Host) -> Origin:
+    """The mission's ``site`` when it gives one, else the world's georeference (an imported
+    scan's), else the default site."""
+    spec, world = host.mission.spec, host.world
+    if "site" not in spec.model_fields_set and world.origin is not None:
+        return Origin(*world.origin)
+    return Origin(spec.site.latitude, spec.site.longitude, spec.site.altitude)
+
+
 def _gnss(host: Host, member: Any, index: int) -> Gnss:
-    g, site, spec = member.sensor_set.gnss, host.mission.spec.site, host.mission.spec
-    return Gnss(host.world, Origin(site.latitude, site.longitude, site.altitude),
-                stream(spec.seed, "gnss", index), g.horizontal_noise, g.vertical_noise,
-                g.satellites, g.degraded_below)
+    g, spec = member.sensor_set.gnss, host.mission.spec
+    return Gnss(host.world, site_origin(host), stream(spec.seed, "gnss", index),
+                g.horizontal_noise, g.vertical_noise, g.satellites, g.degraded_below)
 
 
 def _barometer(host: Host, member: Any, index: int) -> Barometer:
-    b, site, spec = member.sensor_set.barometer, host.mission.spec.site, host.mission.spec
-    return Barometer(Origin(site.latitude, site.longitude, site.altitude),
-                     stream(spec.seed, "barometer", index), b.noise, b.drift, b.drift_time)
+    b, spec = member.sensor_set.barometer, host.mission.spec
+    return Barometer(site_origin(host), stream(spec.seed, "barometer", index), b.noise,
+                     b.drift, b.drift_time)
 
 
 def _magnetometer(host: Host, member: Any, index: int) -> Magnetometer:

@@ -158,3 +158,36 @@ def test_the_api_answers_a_robots_latest_reading(urban_search: Mission, tmp_path
                 client.reading("op1", "gnss")
     finally:
         server.stop()
+
+
+def test_an_imported_georeferenced_tile_gives_the_origin_its_crs_says(tmp_path: Path) -> None:
+    """The Autzen LAS tile's header carries its coordinate system (NAD83 HARN, Oregon's
+    Lambert conformal conic, in feet): the imported world's origin is the recentred
+    ``offset`` taken to WGS 84 by that system (about 44.05 N, 123.07 W, near the stadium), and
+    a GNSS on that world without a mission ``site`` is fixed there."""
+    import laspy
+    import yaml
+    from pyproj import Transformer
+
+    from astralis_des.importers import import_world
+    from astralis_des.importers.options import ImportOptions
+    from astralis_des.world.build import load_world
+
+    root = Path(__file__).resolve().parents[1]
+    out = tmp_path / "autzen.yaml"
+    import_world(root / "data" / "real" / "autzen_trim.laz", out, ImportOptions(voxel=2.0))
+    doc = yaml.safe_load(out.read_text(encoding="utf-8"))
+    origin, offset = doc["site"]["origin"], doc["source"]["offset"]
+    with laspy.open(root / "data" / "real" / "autzen_trim.laz") as f:
+        crs = f.header.parse_crs()
+    lon, lat = Transformer.from_crs(crs, "EPSG:4326", always_xy=True).transform(*offset[:2])
+    assert origin["latitude"] == pytest.approx(lat, abs=1e-6)
+    assert origin["longitude"] == pytest.approx(lon, abs=1e-6)
+    assert 44.0 < lat < 44.1 and -123.1 < lon < -123.0
+    assert origin["altitude"] == pytest.approx(offset[2] * 0.3048, abs=0.01)
+    world = load_world(out)
+    assert world.origin == pytest.approx((origin["latitude"], origin["longitude"],
+                                          origin["altitude"]))
+    fix = Gnss(world, Origin(*world.origin), np.random.default_rng(0), 0.0, 0.0).read(
+        np.zeros(1), np.array([[0.0, 0.0, 30.0]]), yaw_rotation(np.zeros(1)))
+    assert fix.columns["latitude"][0] == pytest.approx(lat, abs=1e-7)

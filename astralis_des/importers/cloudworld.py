@@ -98,11 +98,34 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions) -> Built:
     source = {"kind": "cloud", "points": len(finite), "dropped": dropped,
               "units": _units_note(opts, cloud, scale), "scale": round(scale, 9), "up": "z",
               "offset": offset, "ground": ground.method,
-              "ground_share": round(ground.share, 4), "relief": round(ground.relief, 2)}
+              "ground_share": round(ground.share, 4), "relief": round(ground.relief, 2),
+              "origin": _geodetic(cloud.crs_wkt, offset, vertical)}
     stats = {"ground_share": ground.share, "classified_share": classified, "fill": fill,
              "standing": int(standing.sum()), "canopy": int(canopy.sum())}
     return Built("cloud", site, opts.voxel, boxes, areas, source, "boxes",
                  floors=[0.0], cloud=cloud_xyz, cloud_colors=cloud_rgb, stats=stats)
+
+
+def _geodetic(wkt: str | None, offset: tuple[float, float, float],
+              vertical: float) -> dict[str, float] | None:
+    """Where the world's (0, 0, 0) lies on the Earth (WGS 84), from the file's coordinate
+    system (pyproj): its ``offset`` in the file's units, its height in metres."""
+    if wkt is None:
+        return None
+    from pyproj import CRS, Transformer
+    from pyproj.exceptions import CRSError, ProjError
+
+    try:
+        to_wgs84 = Transformer.from_crs(CRS.from_wkt(wkt), "EPSG:4326", always_xy=True)
+        lon, lat = to_wgs84.transform(offset[0], offset[1])
+    except (CRSError, ProjError) as exc:  # a system pyproj cannot take to WGS 84: no georeference
+        log.warning("the file's coordinate system gives no WGS 84 position (%s): the world "
+                    "is not georeferenced", exc)
+        return None
+    if not (math.isfinite(lat) and math.isfinite(lon)):
+        return None
+    return {"latitude": round(float(lat), 7), "longitude": round(float(lon), 7),
+            "altitude": round(offset[2] * vertical, 3)}
 
 
 def _units_note(opts: ImportOptions, cloud: Cloud, scale: float) -> str:

@@ -66,7 +66,17 @@ def read_las(path: Path) -> Cloud:
         rgb = np.column_stack([np.asarray(las.red), np.asarray(las.green), np.asarray(las.blue)])
         colors = (rgb >> 8 if rgb.max(initial=0) > 255 else rgb).astype(np.uint8)
     scale, vertical, note = _las_units(las.header)
-    return Cloud(xyz, classification, colors, scale, vertical, note)
+    return Cloud(xyz, classification, colors, scale, vertical, note, _las_crs(las.header))
+
+
+def _las_crs(header: Any) -> str | None:
+    """The header's coordinate system as WKT (from its WKT or GeoTIFF keys, by laspy and
+    pyproj), or None."""
+    try:
+        crs = header.parse_crs()
+    except Exception:  # no pyproj, or keys pyproj cannot read: no georeference
+        return None
+    return None if crs is None else str(crs.to_wkt())
 
 
 def _las_units(header: Any) -> tuple[float | None, float | None, str]:

@@ -30,6 +30,7 @@ class Cloud:
     crs_scale: float | None = None  # m per horizontal unit, from the file's CRS
     crs_vertical: float | None = None  # m per vertical unit, when the CRS says
     crs_note: str = ""  # where the units came from, for the world file
+    crs_wkt: str | None = None  # the file's coordinate system (WKT), when it has one
 
 
 @dataclass

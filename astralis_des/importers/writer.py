@@ -98,10 +98,13 @@ def _document(built: Built, source: Path, out: Path, name: str,
     info = {"file": Path(os.path.relpath(source.resolve(), out.parent.resolve())).as_posix(),
             "format": source.suffix.lower().lstrip("."), "kind": built.kind,
             "bytes": source.stat().st_size, "sha256": _sha256(source)}
-    info.update({k: v for k, v in built.source.items() if k != "kind" and v is not None})
+    info.update({k: v for k, v in built.source.items()
+                 if k not in ("kind", "origin") and v is not None})
     info["offset"] = [round(float(v), 4) for v in info["offset"]]  # type: ignore[attr-defined]
-    return {"name": name, "site": {"size": [round(v, 3) for v in built.site]},
-            "source": info, "geometry": geometry}
+    site: dict[str, object] = {"size": [round(v, 3) for v in built.site]}
+    if built.source.get("origin") is not None:  # georeferenced: where (0, 0, 0) lies
+        site["origin"] = built.source["origin"]
+    return {"name": name, "site": site, "source": info, "geometry": geometry}
 
 
 def _sha256(path: Path) -> str:

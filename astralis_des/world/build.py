@@ -52,6 +52,8 @@ def build_world(spec: WorldSpec, blocks: list[Solid] | None = None,
         rooms=parts.rooms, spaces=parts.spaces, solids=tuple(parts.solids),
         stairs_passable_by={b.id: tuple(b.stairs_passable_by) for b in spec.buildings},
         surfaces=roads, imported=imported,
+        origin=None if spec.site.origin is None else (
+            spec.site.origin.latitude, spec.site.origin.longitude, spec.site.origin.altitude),
     )
 
 

@@ -35,6 +35,7 @@ class World:
     stairs_passable_by: dict[str, tuple[str, ...]] = field(default_factory=dict)
     surfaces: tuple[Solid, ...] = ()  # roads and such: drawn, walked on, never in the way
     imported: Imported | None = None  # a digital twin's mesh, cloud and source
+    origin: tuple[float, float, float] | None = None  # (0, 0, 0): latitude, longitude, alt
 
     def memo(self, name: str, limit: int) -> dict[Any, Any]:
         """A cache kept on the world for answers that depend on it and their key alone: it

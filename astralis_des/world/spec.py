@@ -82,8 +82,19 @@ class RoadSpec(Strict):
     width: PositiveFloat = 7.0
 
 
+class GeoOrigin(Strict):
+    """Where the site's (0, 0, 0) lies on the Earth (WGS 84): an imported scan's, from its
+    coordinate system."""
+
+    latitude: float = Field(ge=-90, le=90, description="degrees north")
+    longitude: float = Field(ge=-180, le=180, description="degrees east")
+    altitude: float = Field(0.0, ge=-500, le=9000, description="m, of the ground")
+
+
 class SiteSpec(Strict):
     size: tuple[PositiveFloat, PositiveFloat] = Field(description="outdoor area, metres")
+    origin: GeoOrigin | None = Field(None, description="where (0, 0, 0) lies on the Earth; "
+                                     "the GNSS's origin unless the mission gives its own site")
 
 
 AREA_ID = r"^[A-Za-z][A-Za-z0-9]*\.[1-9][0-9]*\.[1-9][0-9]*\.[1-9][0-9]*$"
