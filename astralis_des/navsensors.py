@@ -235,9 +235,9 @@ def yaw_rotation(yaw: float | FloatArray) -> FloatArray:
     east): ``(3, 3)``, or ``(N, 3, 3)`` for an array of headings."""
     y = np.asarray(yaw, dtype=float)
     c, s = np.cos(y), np.sin(y)
-    zero, one = np.zeros_like(y), np.ones_like(y)
-    out = np.stack([np.stack([c, -s, zero], -1), np.stack([s, c, zero], -1),
-                    np.stack([zero, zero, one], -1)], -2)
+    out = np.zeros((*y.shape, 3, 3))
+    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = c, -s, s, c
+    out[..., 2, 2] = 1.0
     return out
 
 
@@ -346,8 +346,7 @@ def motion_poses(robot: Robot, times: FloatArray) -> tuple[FloatArray, FloatArra
     durations = np.array([e[2].profile.duration for e in entries])
     tt = np.clip(np.minimum(t, ends[i]) - starts[i], 0.0, durations[i])
     # the phases of every profile, keyed by entry + time / (duration + 1): one sorted array
-    keys, s0, v0, a0, t_ph = [], [], [], [], []
-    offsets, cum, points, yaws = [], [], [], []
+    keys, s0, v0, a0, t_ph, offsets, cum, points = [], [], [], [], [], [], [], []
     offset = 0.0
     for k, (_, _, m, _) in enumerate(entries):
         prof = m.profile
@@ -359,13 +358,8 @@ def motion_poses(robot: Robot, times: FloatArray) -> tuple[FloatArray, FloatArra
         offsets.append(offset)
         cum.append(offset + m.cum)
         points.append(m.points)
-        legs = np.diff(m.points[:, :2], axis=0)
-        flat = np.hypot(legs[:, 0], legs[:, 1]) > 1e-6
-        last = np.maximum.accumulate(np.where(flat, np.arange(len(legs)), -1))
-        leg_yaw = np.where(last >= 0, np.arctan2(legs[:, 1], legs[:, 0])[np.maximum(last, 0)],
-                           m.heading) if len(legs) else np.zeros(0)
-        yaws.append(np.append(leg_yaw, leg_yaw[-1] if len(leg_yaw) else m.heading))
         offset += float(m.cum[-1]) + 1.0
+    yaws = _leg_yaws(points, [e[2].heading for e in entries])
     phase = np.searchsorted(np.concatenate(keys), i + tt / (durations[i] + 1.0),
                             side="right") - 1
     dt = tt - np.concatenate(t_ph)[phase]
@@ -376,10 +370,28 @@ def motion_poses(robot: Robot, times: FloatArray) -> tuple[FloatArray, FloatArra
     xp, fp = np.concatenate(cum), np.concatenate(points)
     positions = np.column_stack([np.interp(along, xp, fp[:, k]) for k in range(3)])
     leg = np.clip(np.searchsorted(xp, along, side="right") - 1, 0, len(xp) - 1)
-    yaw = np.where(t > ends[i], np.array([e[3] for e in entries])[i],
-                   np.concatenate(yaws)[leg])
+    yaw = np.where(t > ends[i], np.array([e[3] for e in entries])[i], yaws[leg])
     positions[before], yaw[before] = m0.points[0], m0.heading
     return positions, yaw_rotation(yaw)
+
+
+def _leg_yaws(points: list[FloatArray], headings: list[float]) -> FloatArray:
+    """For each vertex of the paths laid end to end, the heading of the leg leaving it (the
+    last leg's at a path's end); a leg that does not move horizontally keeps the heading
+    before it, and a path starts from its motion's heading."""
+    every = np.concatenate(points)
+    starts = np.cumsum([0] + [len(p) for p in points[:-1]])
+    legs = np.diff(every[:, :2], axis=0, append=every[-1:, :2])
+    ok = np.hypot(legs[:, 0], legs[:, 1]) > 1e-6
+    value = np.arctan2(legs[:, 1], legs[:, 0])
+    ends = starts[1:] - 1  # the leg from a path's last vertex to the next path's first
+    ok[ends] = False
+    ok[-1] = False
+    first = starts[~ok[starts]]  # a path whose first leg does not move: its heading
+    value[first] = np.asarray(headings)[~ok[starts]]
+    ok[first] = True
+    filled: FloatArray = value[np.maximum.accumulate(np.where(ok, np.arange(len(ok)), 0))]
+    return filled
 
 
 @dataclass
