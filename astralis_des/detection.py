@@ -64,6 +64,11 @@ def _face_grid(n: int) -> FloatArray:
 GRIDS = {n: _face_grid(n) for n in (SAMPLES, COARSE)}
 
 
+def face_areas(half: FloatArray) -> FloatArray:
+    """The areas of a box's faces normal to x, y and z, from its half sizes."""
+    return 4 * np.array([half[1] * half[2], half[0] * half[2], half[0] * half[1]])
+
+
 def target_samples(eyes: FloatArray, centres: FloatArray, size: FloatArray,
                    samples: int = SAMPLES) -> tuple[FloatArray, FloatArray]:
     """Sample points on the faces of each target box that turn to its eye, ``(M, K, 3)``, and
@@ -78,7 +83,7 @@ def target_samples(eyes: FloatArray, centres: FloatArray, size: FloatArray,
     offsets = np.where(np.eye(3, dtype=bool)[None, :, None, :],
                        offsets * toward[:, None, None, :], offsets)
     points = centres[:, None, None, :] + offsets  # (M, 3, k, 3)
-    face_area = np.array([half[1] * half[2], half[0] * half[2], half[0] * half[1]]) * 4 / k
+    face_area = face_areas(half) / k
     rays = points - eyes[:, None, None, :]
     r = np.linalg.norm(rays, axis=3)
     along_normal = np.stack([rays[:, a, :, a] for a in range(3)], axis=1)
@@ -192,7 +197,7 @@ def shows_unhidden(view: View, eyes: FloatArray, axes: Axes, centres: FloatArray
     if view.range is not None:
         inside &= z <= view.range
     height = np.where(facing, np.abs(d[shown]) - half, 0.0)  # the eye over each face's plane
-    face_area = np.array([half[1] * half[2], half[0] * half[2], half[0] * half[1]]) * 4 / k
+    face_area = face_areas(half) / k
     each = (face_area * height)[:, :, None] * view.focal**2 / np.maximum(z, NEAR) ** 3
     pixels = np.minimum((each * inside * facing[:, :, None]).sum(axis=(1, 2)),
                         float(view.pixels[0] * view.pixels[1]))
@@ -239,8 +244,7 @@ def cull(view: View, eyes: FloatArray, axes: Axes, centres: FloatArray, size: Fl
     if inside.any() and view.min_pixels <= view.pixels[0] * view.pixels[1]:
         m, n = np.nonzero(inside)
         over = np.maximum(np.abs(d[m, n]) - half, 0.0)  # the eye over each face's plane
-        faces = 4 * np.array([half[1] * half[2], half[0] * half[2], half[0] * half[1]])
-        bound = view.focal**2 * (over @ faces) / z[m, n].max(axis=1) ** 3
+        bound = view.focal**2 * (over @ face_areas(half)) / z[m, n].max(axis=1) ** 3
         ok = bound >= view.min_pixels * 1.001
         sure[m[ok], n[ok]] = True
     return np.nonzero(sure), np.nonzero(~culled & ~sure)

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from astralis_des.detection import Sighting, cull, predict_pixels, shows_unhidden
+from astralis_des.detection import PROBES, Sighting, cull, predict_pixels, shows_unhidden
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kinds import TARGET_HEIGHT
 from astralis_des.view import Axes, View, look_headings, pick, travel_headings
@@ -34,7 +34,6 @@ BOUND_SHARE = 0.8  # of min_pixels the unhidden bound (sampled coarser) must rea
 PASSES = 6  # interleaved passes over a path's points when judging coverage
 MEMO_SWEEPS = 65536  # coverage answers a world keeps (16-byte digests of their inputs)
 __all__ = ["GeometricSensor", "Sighting", "in_frame"]
-CORNERS = np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5])).reshape(3, -1).T
 
 
 class GeometricSensor:
@@ -207,7 +206,7 @@ def in_frame(view: View, eyes: FloatArray, headings: FloatArray, centres: FloatA
              axes: Axes | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The pairs (eye ``ei[m]``, target box at ``centres[ci[m]]``) where any corner or the
     centre of the box is in the camera's frame and reach; ``axes``: those of ``headings``."""
-    probes = centres[ci][:, None, :] + np.vstack([np.zeros(3), CORNERS])[None, :, :] * size
+    probes = centres[ci][:, None, :] + PROBES[None, :, :] * size
     k = probes.shape[1]
     rows = np.repeat(ei, k)
     inside = view.sees(eyes[rows], headings[rows], probes.reshape(-1, 3),

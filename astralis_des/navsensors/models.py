@@ -115,6 +115,15 @@ class Readings:
     def __len__(self) -> int:
         return len(self.t)
 
+    @staticmethod
+    def joined(parts: list[Readings]) -> Readings:
+        """The readings of ``parts`` one after the other."""
+        if not parts:
+            return Readings(np.zeros(0), {})
+        return Readings(np.concatenate([p.t for p in parts]),
+                        {k: np.concatenate([p.columns[k] for p in parts])
+                         for k in parts[0].columns})
+
     def row(self, i: int) -> dict[str, Any]:
         """Reading ``i`` as plain numbers (the API's answer)."""
         out: dict[str, Any] = {"t": float(self.t[i])}
@@ -123,13 +132,6 @@ class Readings:
             plain = value.tolist() if isinstance(value, np.ndarray) else value.item()
             out[name] = None if isinstance(plain, float) and not math.isfinite(plain) else plain
         return out
-
-
-def _joined(parts: list[Readings]) -> Readings:
-    if not parts:
-        return Readings(np.zeros(0), {})
-    return Readings(np.concatenate([p.t for p in parts]),
-                    {k: np.concatenate([p.columns[k] for p in parts]) for k in parts[0].columns})
 
 
 @dataclass

@@ -19,7 +19,6 @@ from astralis_des.navsensors.models import (
     Magnetometer,
     Origin,
     Readings,
-    _joined,
     yaw_rotation,
 )
 from astralis_des.streams import stream
@@ -109,7 +108,7 @@ class PoseSensors:
     def readings(self, rid: str, name: str) -> Readings:
         parts = self._parts.get((rid, name), [])
         if len(parts) > 1:
-            self._parts[rid, name] = parts = [_joined(parts)]
+            self._parts[rid, name] = parts = [Readings.joined(parts)]
         return parts[0] if parts else Readings(np.zeros(0), {})
 
 

@@ -21,11 +21,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from astralis_des.physics.client import PhysicsClient
+from astralis_des.physics.planar import TINY
+from astralis_des.physics.sensors import NO_BODY, _body_pose, _need_rng
 from astralis_des.world.geometry import FloatArray
 
 IntArray = NDArray[np.int32]
-NO_BODY = -1
-TINY = 1e-12  # a direction component smaller than this is taken as this
 SLACK = 1e-9  # rad: the angular windows are widened by this
 
 
@@ -45,8 +45,7 @@ class Lidar3D:
                  range_max: float = 100.0, range_min: float = 0.1, noise_std: float = 0.01,
                  rng: np.random.Generator | None = None, start_offset: float = 0.5,
                  mount: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None:
-        if noise_std > 0 and rng is None:
-            raise ValueError("Lidar3D has noise but no rng: pass a numpy.random.Generator")
+        _need_rng(noise_std, rng, "Lidar3D")
         self.client, self.body, self.rng = client, body, rng
         self.range_max, self.range_min, self.noise_std = range_max, range_min, noise_std
         self.start = start_offset
@@ -59,9 +58,8 @@ class Lidar3D:
 
     def pose(self) -> tuple[FloatArray, float]:
         """The sensor's centre and the body's heading (the beams' zero azimuth)."""
-        pos, quat = self.client.call("getBasePositionAndOrientation", self.body)
-        m = np.array(self.client.call("getMatrixFromQuaternion", quat)).reshape(3, 3)
-        return np.asarray(pos) + m @ self.mount, math.atan2(m[1, 0], m[0, 0])
+        position, m = _body_pose(self.client, self.body)
+        return position + m @ self.mount, math.atan2(m[1, 0], m[0, 0])
 
     def directions(self, heading: float) -> FloatArray:
         a = self.azimuths + heading
@@ -80,7 +78,7 @@ class Lidar3D:
         ground = np.where(down, -centre[2] / np.where(down, dirs[..., 2], -1.0), np.inf)
         closer = (ground >= self.start) & (ground < t) & (centre[2] > 0.0)
         t, ids = np.where(closer, ground, t), np.where(closer, self.client.ground, ids)
-        self._bodies(centre, dirs, t, ids)
+        self._bodies(centre, dirs, heading, t, ids)
         ranges = t.copy()
         if self.noise_std > 0 and self.rng is not None:  # drawn for every beam
             ranges = ranges + self.rng.normal(0.0, self.noise_std, ranges.shape)
@@ -89,7 +87,7 @@ class Lidar3D:
         points = centre + np.where(missed, np.nan, ranges)[..., None] * dirs
         return Scan3D(ranges, points, ids.astype(np.int32), time)
 
-    def _bodies(self, centre: FloatArray, dirs: FloatArray, t: FloatArray,
+    def _bodies(self, centre: FloatArray, dirs: FloatArray, heading: float, t: FloatArray,
                 ids: NDArray[Any]) -> None:
         """Bullet along the beams that cross another body's bounding box, to their first
         static hit (or the range): a nearer body's hit replaces it."""
@@ -103,9 +101,8 @@ class Lidar3D:
             return
         aabbs = np.array([client.call("getAABB", b, link) for b, link in parts])
         stop = np.minimum(t, reach)
-        crossed, _ = cast_boxes(centre, dirs, math.atan2(dirs[0, 0, 1], dirs[0, 0, 0]),
-                                self.elevations, self.step, aabbs[:, 0], aabbs[:, 1],
-                                0.0, reach, inside=True)
+        crossed, _ = cast_boxes(centre, dirs, heading, self.elevations, self.step,
+                                aabbs[:, 0], aabbs[:, 1], 0.0, reach, inside=True)
         rows = np.flatnonzero((crossed < stop).ravel())
         if not len(rows):
             return

@@ -133,7 +133,8 @@ class VoxelMap(_FieldGrid):
             return cells
         # the occupied voxels are those of the boxes' cell ranges: listed box by box, then
         # each once, in the order of np.argwhere
-        shape = np.array(self.squared.shape if self.squared is not None else (0, 0, 0))
+        assert self.squared is not None  # boxes' ranges come with the squared distances
+        shape = self.squared.shape
         flat = []
         for first, stop in zip(*self.blocks, strict=True):
             first = np.maximum(first, (0, 0, k0))

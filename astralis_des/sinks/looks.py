@@ -112,3 +112,10 @@ def _human(rr: Any, rec: Any, entity: str, color: tuple[int, int, int, int]) -> 
 
 
 SHAPES = {"uav": _uav, "ugv": _ugv, "human": _human}
+
+
+def by_height(z: np.ndarray, top: float = 12.0) -> np.ndarray:
+    """RGB of points by their height: blue on the ground to a pale yellow ``top`` m up (the
+    planner's occupancy map, the 3-D lidar's returns)."""
+    h = np.clip(np.asarray(z, dtype=float) / top, 0.0, 1.0)
+    return np.column_stack([60 + 150 * h, 90 + 60 * h, 200 - 120 * h]).astype(np.uint8)

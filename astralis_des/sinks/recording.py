@@ -12,7 +12,7 @@ import numpy as np
 from astralis_des.kernel.events import LEVELS, Record
 from astralis_des.sinks import paths
 from astralis_des.sinks.blueprint import blueprint
-from astralis_des.sinks.looks import TABLE_II_COLORS, by_place, log_body, robot_colors
+from astralis_des.sinks.looks import TABLE_II_COLORS, by_height, by_place, log_body, robot_colors
 from astralis_des.sinks.replay import log_lanes, log_metrics, log_rounds, metrics, task_lanes
 from astralis_des.sinks.sensor_log import log_detections, log_pose_sensors, log_sensors
 from astralis_des.world.clutter import Placed
@@ -127,10 +127,8 @@ class RerunRecorder:
         navigator = self.sim.navigator
         if navigator.map_built:  # the planner's occupancy map, when this run used it
             points = navigator.occupied_points()
-            heights = np.clip(points[:, 2] / 12.0, 0.0, 1.0)
-            colors = np.column_stack([60 + 150 * heights, 90 + 60 * heights,
-                                      200 - 120 * heights]).astype(np.uint8)
-            rec.log(paths.WORLD_OCCUPANCY, rr.Points3D(points, radii=0.1, colors=colors),
+            rec.log(paths.WORLD_OCCUPANCY, rr.Points3D(points, radii=0.1,
+                                                       colors=by_height(points[:, 2])),
                     static=True)
         self._log_movers(result.end_time)
         perception = getattr(self.sim.cosim, "perception", None)

@@ -13,18 +13,13 @@ import numpy as np
 
 from astralis_des.kernel.events import Record
 from astralis_des.sinks import paths
+from astralis_des.sinks.looks import by_height
 
 if TYPE_CHECKING:
     from astralis_des.navsensors import PoseSensors
     from astralis_des.physics.perception import KeptCloud, KeptFrame, KeptScan, Perception
 
 Kept = TypeVar("Kept", "KeptFrame", "KeptScan", "KeptCloud")
-
-
-def by_height(z: np.ndarray, top: float = 12.0) -> np.ndarray:
-    """RGB a point by its height: blue on the ground, through green, to yellow ``top`` up."""
-    h = np.clip(np.asarray(z, dtype=float) / top, 0.0, 1.0)
-    return np.column_stack([60 + 190 * h, 90 + 150 * np.sqrt(h), 200 - 170 * h]).astype(np.uint8)
 
 
 def _by_robot(items: Sequence[Kept]) -> dict[str, list[Kept]]:

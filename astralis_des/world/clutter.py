@@ -80,18 +80,14 @@ class Occupancy:
         kept: dict[float, tuple[BoolArray, BoolArray]] = \
             space.__dict__.setdefault("_empty_reach", {})
         if passage not in kept:
-            walk_eroded = erode(walkable(space, taken), passage / 2 / space.cell)
-            reach = reachable(space, taken, passage, walk_eroded)[1]
-            reach.setflags(write=False)
-            walk_eroded.setflags(write=False)
-            kept[passage] = (reach, walk_eroded)
-        reach, walk_eroded = kept[passage]
-        return cls(taken, taken.copy(), keepout, reach, walk_eroded)
+            kept[passage] = _reach(space, taken, passage)
+            for array in kept[passage]:
+                array.setflags(write=False)
+        return cls(taken, taken.copy(), keepout, *kept[passage])
 
     def settle(self, space: FreeSpace, passage: float) -> None:
         """Reachability again after footprints were stamped by hand."""
-        self.walk_eroded = erode(walkable(space, self.taken), passage / 2 / space.cell)
-        self.reach = reachable(space, self.taken, passage, self.walk_eroded)[1]
+        self.reach, self.walk_eroded = _reach(space, self.taken, passage)
 
     def stamp(self, space: FreeSpace, box: Box, clearance: float) -> None:
         self.taken[space.cells(box.lo, box.hi)] = True
@@ -320,9 +316,17 @@ def _candidates(space: FreeSpace, occupied: Occupancy, w: float, d: float, again
 
 def _wall_tables(space: FreeSpace) -> list[np.ndarray]:
     """Summed-area tables of the cells along a wall towards -x, +x, -y, +y (once a room)."""
-    kept: list[np.ndarray] = space.__dict__.get("_wall_tables") or \
-        space.__dict__.setdefault("_wall_tables", [summed(s) for s in space.wall_sides()])
+    if "_wall_tables" not in space.__dict__:
+        space.__dict__["_wall_tables"] = [summed(side) for side in space.wall_sides()]
+    kept: list[np.ndarray] = space.__dict__["_wall_tables"]
     return kept
+
+
+def _reach(space: FreeSpace, taken: BoolArray, passage: float) -> tuple[BoolArray, BoolArray]:
+    """The cells reachable from the door, and the walkable floor eroded by half the passage
+    (what placing the next footprint updates around it)."""
+    walk_eroded = erode(walkable(space, taken), passage / 2 / space.cell)
+    return reachable(space, taken, passage, walk_eroded)[1], walk_eroded
 
 
 def _backs_onto_wall(side: np.ndarray, wall: int, kx: int, ky: int,
