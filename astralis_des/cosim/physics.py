@@ -31,6 +31,7 @@ from astralis_des.physics.local import RATE as LOCAL_RATE
 from astralis_des.physics.local import LocalLayer
 from astralis_des.physics.make_way import aside
 from astralis_des.physics.perception import Perception
+from astralis_des.physics.sensors import _body_pose
 from astralis_des.physics.track import Track
 from astralis_des.physics.ugv_driver import UgvDriver
 from astralis_des.plugins import COSIMS
@@ -241,9 +242,8 @@ class PhysicsCoSim:
 
     def body_pose(self, robot: Robot) -> tuple[FloatArray, FloatArray]:
         """Where the robot is now, and world from body of its simulated body."""
-        _, quat = self.client.call("getBasePositionAndOrientation", self.drivers[robot.id].body)
-        return (self.drivers[robot.id].position(),
-                np.array(self.client.call("getMatrixFromQuaternion", quat)).reshape(3, 3))
+        driver = self.drivers[robot.id]
+        return driver.position(), _body_pose(self.client, driver.body)[1]
 
     def halt(self, robot: Robot) -> None:
         if self.active.pop(robot.id, None) is not None:
