@@ -223,3 +223,25 @@ def test_a_uav_setting_off_meets_the_walkers_where_they_are_now() -> None:
     assert done.triggered and done.value.ok, done.value.message
     assert [e for e in sim.log.records if e["kind"] in ("contact", "fault")] == []
     sim.finish()
+
+
+def test_a_husky_standing_by_the_stairs_makes_way_along_the_corridor() -> None:
+    """The fidelity benchmark's scenario 18 (naive): the Husky stood idle on the second
+    floor's corridor 2 m from the stairs, on the person's way up. The corridor (2.5 m, 2.3 m
+    where it meets the stair hall) leaves no spot 1 to 2 m aside that clears the person's
+    path by both bodies and a margin (1.17 m), so it never made way and the person failed
+    'stuck'. It now goes along the corridor, away from the person, past the stairs; the
+    person goes up without touching it."""
+    sim = corridor_mission([{"id": "human1", "kind": "human", "start": [70.0, CORRIDOR_Y, 3.5]},
+                            {"id": "ugv1", "kind": "ugv", "start": [65.13, CORRIDOR_Y, 3.5]}])
+    sim.start()
+    done = sim.enqueue("human1", "move", room="A.3.1.3")
+    sim.advance(60.0)
+    assert done.triggered and done.value.status.value == "succeeded"
+    (made,) = [e for e in sim.log.records if e["kind"] == "make_way"]
+    assert (made["robot"], made["for_robot"]) == ("ugv1", "human1")
+    spot = np.array(made["to"])
+    assert spot[0] < 63.2 - 1.17 and abs(spot[1] - CORRIDOR_Y) < 0.01  # past the stairs
+    path = np.concatenate([p for _, p in sim.robots["human1"].plans])
+    assert np.linalg.norm(path[:, :2] - spot[:2], axis=1).min() >= 1.17
+    assert not contacts_between(sim, "human1", "ugv1")

@@ -19,9 +19,6 @@ from astralis_des.world.model import Room
 
 DOOR_OFFSET = 0.6  # m in front of a door's wall: where robots stop by a door
 TURN_MARGIN = 0.1  # m kept between a wall and the circle a body sweeps turning on the spot
-LANDING_CLEAR = 0.45  # m: half the side of the square of floor a landing UAV needs free
-LANDING_RINGS = (0.0, 0.6, 1.2, 1.8, 2.4)  # m around a UAV where it looks for that square
-ROBOT_ROOM = 0.7  # m: half the side of the square another robot takes (the Husky turning)
 LOOK_AROUND = 2.0  # s spent looking round a room that cannot be searched by its pattern
 ActionGen = Generator[simpy.Event, Any, ActionResult]
 StepGen = Generator[simpy.Event, Any, float]
@@ -85,64 +82,6 @@ def take_off(ctx: Context, robot: Robot) -> StepGen:
     distance = yield from climb(ctx, robot, robot.height)
     robot.airborne = True
     ctx.log.emit("took_off", robot.id, height=round(robot.height, 3))
-    return distance
-
-
-def landing_spot(ctx: Context, robot: Robot) -> FloatArray:
-    """Where a UAV can come straight down: over its own spot if the column under it is free
-    of walls, furniture and people who stay put, else over the nearest free one on rings
-    around it that it can fly to in a straight line (its own spot if none is)."""
-    here = robot.position(ctx.env.now)
-    floor = ctx.world.floor_below(here)
-    room = ctx.world.room_at((here[0], here[1], floor + 0.5))
-    scene = ctx.sensor.scene
-    boxes = scene.blockers([room.id] if room is not None else [])
-    walks = [*scene.movers, *scene.avatar_movers([room.id] if room is not None else [])]
-    if walks:  # nor on the loop a walker or an obstacle goes round
-        boxes = np.concatenate([boxes, *[_along(m.loop, m.size) for m in walks]])
-    others = [r.position(ctx.env.now) for r in ctx.robots.values() if r is not robot]
-    if others:  # nor on another robot (a UGV under it in a corridor)
-        at = np.array(others)
-        lo = np.column_stack([at[:, :2] - ROBOT_ROOM, np.full(len(at), -1e3)])
-        hi = np.column_stack([at[:, :2] + ROBOT_ROOM, at[:, 2] + 0.5])
-        boxes = np.concatenate([boxes, np.stack([lo, hi], axis=1)])
-    for reach in LANDING_RINGS:
-        angles = np.linspace(0.0, 2 * np.pi, 1 if reach == 0 else 12, endpoint=False)
-        for angle in angles:
-            spot = here + reach * np.array([np.cos(angle), np.sin(angle), 0.0])
-            lo = np.array([spot[0] - LANDING_CLEAR, spot[1] - LANDING_CLEAR, floor + 0.02])
-            hi = np.array([spot[0] + LANDING_CLEAR, spot[1] + LANDING_CLEAR, here[2]])
-            if np.any(np.all((boxes[:, 0] < hi) & (boxes[:, 1] > lo), axis=1)):
-                continue
-            if reach == 0 or bool(scene.line_of_sight(here, spot)[0]):
-                return spot
-    return here
-
-
-def _along(loop: FloatArray, size: tuple[float, float, float]) -> FloatArray:
-    """``(K, 2, 3)`` boxes of a body of ``size`` every 0.2 m along its ``loop``."""
-    legs = np.diff(loop, axis=0)
-    steps = np.maximum(np.ceil(np.linalg.norm(legs, axis=1) / 0.2).astype(int), 1)
-    pts = np.vstack([a + np.outer(np.arange(n) / n, leg)
-                     for a, leg, n in zip(loop[:-1], legs, steps, strict=True)])
-    half = np.asarray(size) / 2
-    return np.stack([pts - half, pts + half], axis=1)
-
-
-def land(ctx: Context, robot: Robot) -> StepGen:
-    """A flying UAV comes straight down onto the floor (a ``landed`` event): under it, or
-    beside it where the floor under it is taken (:func:`landing_spot`)."""
-    rest = KIND_DEFAULTS[robot.kind].rest
-    if not robot.airborne or rest is None:
-        return 0.0
-    here, spot = robot.position(ctx.env.now), landing_spot(ctx, robot)
-    distance = 0.0
-    if float(np.linalg.norm(spot - here)) > 1e-6:
-        distance = yield from traverse(ctx, robot, np.vstack([here, spot]), sense=False)
-    robot.airborne = False  # from here on it is coming down (stopped, it takes off again)
-    distance += yield from climb(ctx, robot, rest)
-    ctx.log.emit("landed", robot.id, position=[round(float(v), 3)
-                                               for v in robot.position(ctx.env.now)])
     return distance
 
 

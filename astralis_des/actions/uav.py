@@ -9,13 +9,13 @@ from astralis_des.actions.common import (
     dwell,
     failed,
     footprint_spacing,
-    land,
     plane_to_floor,
     result,
     room_of,
     search_path,
     take_off,
 )
+from astralis_des.actions.landing import land
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task, TaskStatus
 from astralis_des.plugins import ACTIONS

@@ -159,6 +159,10 @@ class PhysicsCoSim:
         """Where (at its pose height) the robot's body is clear of walls and furniture."""
         return self._navigator.fits(self.robots[rid], points)
 
+    def stands(self, rid: str, points: FloatArray) -> np.ndarray:
+        """Where the robot can stand and set off from (a Husky's rectangle fits there)."""
+        return self._navigator.stands(self.robots[rid], points)
+
     def _move_movers(self) -> None:
         """Put the movers near a moving robot where they are at the end of the coming tick.
         Done at the contact checks' rate (30 Hz): a walker then jumps about 3 cm at a time;

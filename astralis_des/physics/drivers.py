@@ -141,6 +141,8 @@ class HumanDriver(Avoiding):
         if self.elapsed >= self.motion.duration:
             return "arrived"
         remaining = self.motion.length - self.progress()
+        if self.held and remaining < ARRIVED:  # held a step from its goal: it is there
+            return "arrived"
         return "arrived" if remaining < self.arrive_within - ARRIVED else None
 
     def _overlap(self, bodies: list[int]) -> float:

@@ -153,7 +153,9 @@ class LocalLayer:
         route = ahead[:, :2] + me.offset
         if len(route) < 3:  # at the end of its path: the way it is headed
             route = me.xy + forward * np.arange(0.0, PATH_AHEAD, SAMPLE)[:, None]
-        hold, shift, aside, blockers = self._decide(me, others, forward, right, speed, route)
+        heights = ahead[:, 2] if me.kind == "uav" and len(ahead) >= 3 else None
+        hold, shift, aside, blockers = self._decide(me, others, forward, right, speed, route,
+                                                    heights)
         door = doors[rid]
         in_door = self._door_taken(rid, me, door, others, doors) if door is not None else None
         if in_door is not None:
@@ -184,11 +186,14 @@ class LocalLayer:
         driver.avoid(hold, shift, climb)
 
     def _decide(self, me: Body, others: list[Body], forward: FloatArray, right: FloatArray,
-                speed: float, route: FloatArray) -> tuple[bool, FloatArray, bool, list[Body]]:
+                speed: float, route: FloatArray, heights: FloatArray | None = None
+                ) -> tuple[bool, FloatArray, bool, list[Body]]:
         """Hold or not; the shift off the path (a vector in the plane: keep right, or step
         round something standing still); whether that shift steps round something (all of
         it, or no use); and the bodies the robot holds for. ``route``: where the robot will
-        be over the next metres (its path ahead, as shifted now), ``SAMPLE`` apart."""
+        be over the next metres (its path ahead, as shifted now), ``SAMPLE`` apart; a UAV's
+        ``heights`` along it: a body it would pass over where its way meets it (a person
+        beyond a door it ducks through under the lintel) is no reason to hold."""
         hold, shift, aside = False, np.zeros(2), False
         blockers: list[Body] = []
         stop = STOP_RANGE + BRAKING * speed
@@ -203,6 +208,10 @@ class LocalLayer:
             if gap > PASS_RANGE:
                 continue
             reach, off_route = on_route(route, other.xy, other.velocity)
+            if heights is not None and gap > 0.0:
+                there = float(heights[min(round(reach / SAMPLE), len(heights) - 1)])
+                if other.z[1] < there + HEIGHTS["uav"][0]:
+                    continue  # under its way where it gets there
             if along > 0 and off_route < lane + SHIFT:
                 if float(other.velocity @ forward) < -0.05:  # coming towards us: keep right
                     if not aside and abs(across + float(me.offset @ right)) < lane + SHIFT:

@@ -182,6 +182,10 @@ class UgvDriver(Avoiding):
         if self.held or self._wait_for_lift():
             self.husky.drive(0.0, 0.0)
             self._best = (self.progress(), t)  # waiting is not being blocked
+            if self.held:  # its way round what holds it is set while it waits (else the
+                # hold, for a body on the unshifted way, never ends)
+                self.shift = ramp(self.shift, self.shift_to, self.shift_rate * self.period)
+                self.husky.offset = self.shift
             return None
         if t < self.backing_until:
             self.husky.drive(-BACK_OFF_SPEED, 0.0)

@@ -18,6 +18,7 @@ import numpy as np
 
 from astralis_des.errors import InputError
 from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.planning.footprint import RIM, facing, fits_turned, rectangle_points
 from astralis_des.planning.lintels import Lintels
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
@@ -32,7 +33,6 @@ BODY_RADIUS = {"uav": 0.3, "ugv": 0.35, "human": 0.25}  # m, a disc around the b
 # up to a quarter metre (measured), and it should not brush a person's head
 KEEP_OUT = {"uav": 0.2, "ugv": 0.0, "human": 0.0}
 WINDOW = 3.0  # m around a leg that its planner may use
-RIM = 0.25  # m between the points a rectangular footprint is checked at, along its edges
 NUDGE = 0.6  # m: how far a leg's end in collision may be moved to a free point
 CELL = 0.1  # m, walkers' floor grid
 LIFT_SLACK = 0.05  # m above the clearance a UAV's point lifted over furniture is put
@@ -187,6 +187,23 @@ class Navigator(Lintels):
             ok[mine] = self._floor_grid(lo, hi, float(floor)).free(pts[mine, :2], radius)
         return ok
 
+    def stands(self, robot: Robot, points: FloatArray) -> np.ndarray:
+        """Where the robot can stand and set off from: it fits (:meth:`fits`), and a long
+        body's rectangle (the Husky's) fits at some heading, as its planner needs of a start
+        or a goal."""
+        pts = np.atleast_2d(np.asarray(points, dtype=float))
+        ok = self.fits(robot, pts)
+        footprint = KIND_DEFAULTS[robot.kind].footprint
+        if footprint is None or not ok.any():
+            return ok
+        clearance = self.cfg.margin + RIM / 2
+        reach = (KIND_DEFAULTS[robot.kind].swept_radius or 0.0) + clearance + 2 * CELL
+        for k in np.flatnonzero(ok):
+            floor = self.world.floor_below(pts[k] - np.array([0.0, 0.0, robot.height]))
+            grid = self._floor_grid(pts[k, :2] - reach, pts[k, :2] + reach, floor)
+            ok[k] = bool(fits_turned(grid, pts[k:k + 1], footprint, clearance)[0])
+        return ok
+
     def prepare(self) -> None:
         """Build the planner's map now rather than on the first route (a server does, so
         that no request waits for it)."""
@@ -272,7 +289,7 @@ class Navigator(Lintels):
         stands closer to furniture than its margins allow, a goal beside a person) is moved
         to the nearest free point within ``NUDGE`` first: the robot leaves from where it is,
         and stops as near the goal as it can."""
-        fits = self.fits(robot, np.array([a, b]))
+        fits = self.stands(robot, np.array([a, b]))
         a2 = a if fits[0] else self._nudge(robot, a)
         b2 = b if fits[1] else self._nudge(robot, b)
         if a2 is None or b2 is None:
@@ -284,12 +301,12 @@ class Navigator(Lintels):
         return np.vstack([*head, path]), ""
 
     def _nudge(self, robot: Robot, point: FloatArray) -> FloatArray | None:
-        """The nearest point within ``NUDGE`` (same height) where the robot fits."""
+        """The nearest point within ``NUDGE`` (same height) where the robot can stand."""
         angles = np.arange(16) * (math.pi / 8)
         for r in np.arange(0.1, NUDGE + 1e-9, 0.1):
             ring = point + r * np.column_stack([np.cos(angles), np.sin(angles),
                                                 np.zeros(16)])
-            ok = self.fits(robot, ring)
+            ok = self.stands(robot, ring)
             if ok.any():
                 return np.asarray(ring[int(np.argmax(ok))])
         return None
@@ -330,7 +347,7 @@ class Navigator(Lintels):
             else:
                 def valid(states: FloatArray) -> np.ndarray:
                     return np.asarray(grid.free(states[:, :2], radius))
-            start, goal = _facing(valid, start), _facing(valid, goal)
+            start, goal = facing(valid, start), facing(valid, goal)
             plan = plan_se2(valid, lo[:2], hi[:2], start, goal,
                             turning_radius=self.cfg.turning_radius, budget=budget,
                             space=self.cfg.ugv_space, seed=seed, resolution=0.05)
@@ -367,33 +384,6 @@ class Navigator(Lintels):
             occupied |= np.all((centers >= box[0, :2] - CELL / 2) &
                                (centers <= box[1, :2] + CELL / 2), axis=1)
         return GridMap.from_occupancy(occupied.reshape(tuple(shape)), lo, CELL)
-
-
-def rectangle_points(states: FloatArray, length: float, width: float) -> FloatArray:
-    """``(N, K, 2)``: points along the rim of a ``length`` x ``width`` body (and its centre)
-    at each ``(x, y, heading)`` state, ``RIM`` apart at most."""
-    along = np.linspace(-length / 2, length / 2, max(2, math.ceil(length / RIM) + 1))
-    across = np.linspace(-width / 2, width / 2, max(2, math.ceil(width / RIM) + 1))
-    rim = np.vstack([np.column_stack([along, np.full_like(along, -width / 2)]),
-                     np.column_stack([along, np.full_like(along, width / 2)]),
-                     np.column_stack([np.full_like(across, -length / 2), across]),
-                     np.column_stack([np.full_like(across, length / 2), across]),
-                     [[0.0, 0.0]]])
-    cos, sin = np.cos(states[:, 2]), np.sin(states[:, 2])
-    x = states[:, None, 0] + cos[:, None] * rim[None, :, 0] - sin[:, None] * rim[None, :, 1]
-    y = states[:, None, 1] + sin[:, None] * rim[None, :, 0] + cos[:, None] * rim[None, :, 1]
-    return np.stack([x, y], axis=2)
-
-
-def _facing(valid, state: FloatArray) -> FloatArray:  # type: ignore[no-untyped-def]
-    """``state`` (x, y, heading), turned to the nearest heading its footprint fits at, if
-    it does not fit at its own (a long body by a wall fits along it, not across)."""
-    turns = np.deg2rad(np.array([0, 15, -15, 30, -30, 45, -45, 60, -60, 75, -75, 90, -90,
-                                 105, -105, 120, -120, 135, -135, 150, -150, 165, -165, 180]))
-    candidates = np.repeat(state[None, :], len(turns), axis=0)
-    candidates[:, 2] = state[2] + turns
-    ok = valid(candidates)
-    return np.asarray(candidates[int(np.argmax(ok))]) if ok.any() else state
 
 
 def level_legs(points: FloatArray) -> FloatArray:

@@ -1,0 +1,206 @@
+"""Landing: where a UAV comes down, and the way there.
+
+A UAV lands where the square of floor under it is free of walls, furniture, other robots and
+the loops that walkers (avatars, moving obstacles) go round; a walker would walk into a UAV
+standing on its loop and tip it over. It looks first on rings around it (the usual case),
+then on a fine grid over its room (a room whose walkers' loop leaves only a strip free), and
+flies to the spot it finds in a straight line its body clears, else by a route.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from astralis_des.actions.common import StepGen, climb, route, traverse
+from astralis_des.kernel.contracts import Context
+from astralis_des.kernel.robot import Robot
+from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.world.geometry import FloatArray
+from astralis_des.world.model import Room
+
+log = logging.getLogger(__name__)
+
+LANDING_CLEAR = 0.45  # m: half the side of the square of floor a landing UAV needs free
+LANDING_RINGS = (0.0, 0.6, 1.2, 1.8, 2.4)  # m around a UAV where it looks for that square
+LANDING_GRID = 0.1  # m between the spots of the finer search when no ring has one
+LANDING_FAR = 4.0  # m around a UAV outside any room where the finer search looks
+IN_LINE = 400  # the nearest free spots of the finer search tried in a straight line
+ROUTED = 3  # the nearest free spots of the finer search tried by a route, if none is in line
+ROBOT_ROOM = 0.7  # m: half the side of the square another robot takes (the Husky turning)
+DOOR_KEEP = 1.0  # m from a doorway's centre where the finer search lands no UAV
+BODY_CLEAR = 0.4  # m: half the side of the square a UAV sweeps flying to its spot
+BODY_BAND = 0.15  # m above and below its height that it sweeps
+
+
+def landing_way(ctx: Context, robot: Robot) -> FloatArray:
+    """The points a UAV flies, level, to above where it comes straight down: its own spot,
+    or the nearest free one (see the module's notes). Where none is free it stays where it
+    is (and says so in the log)."""
+    here = robot.position(ctx.env.now)
+    floor = ctx.world.floor_below(here)
+    room = ctx.world.room_at((here[0], here[1], floor + 0.5))
+    rooms = [room.id] if room is not None else []
+    scene = ctx.sensor.scene
+    taken = _taken(ctx, robot, here, rooms)
+    solid = scene.blockers(rooms)
+    for reach in LANDING_RINGS:
+        angles = np.linspace(0.0, 2 * np.pi, 1 if reach == 0 else 12, endpoint=False)
+        for angle in angles:
+            spot = here + reach * np.array([np.cos(angle), np.sin(angle), 0.0])
+            if _free(taken, spot[None, :], floor)[0] and (reach == 0 or (
+                    _in(ctx, spot, floor, room) and bool(scene.line_of_sight(here, spot)[0])
+                    and _clears(solid, here, spot))):
+                return np.vstack([here, spot]) if reach else here[None, :]
+    searches = [_grid(ctx, here, floor, room)]
+    if room is not None:  # none in its room: out of it, to the corridor
+        searches.append(_grid(ctx, here, floor, None))
+    for spots in searches:
+        spots = spots[_free(taken, spots, floor) & ~_by_door(ctx, spots, floor)]
+        way = _nearest_way(ctx, robot, here, spots, solid)
+        if way is not None:
+            return way
+    log.warning("%s: no free spot to land on near %s: it comes down where it is", robot.id,
+                np.round(here, 2).tolist())
+    return here[None, :]
+
+
+def _nearest_way(ctx: Context, robot: Robot, here: FloatArray, spots: FloatArray,
+                 solid: FloatArray) -> FloatArray | None:
+    """The way to the nearest of the free ``spots`` reached in a straight line (of the
+    ``IN_LINE`` nearest), else by a route to one of the ``ROUTED`` nearest; None if
+    neither."""
+    spots = spots[np.argsort(np.linalg.norm(spots[:, :2] - here[:2], axis=1), kind="stable")]
+    for spot in spots[:IN_LINE]:
+        if _clears(solid, here, spot):
+            return np.vstack([here, spot])
+    for spot in spots[:ROUTED]:
+        way = route(ctx, robot, ctx.world.on_floor(spot))
+        if way.points is not None:
+            return way.points
+    return None
+
+
+def _taken(ctx: Context, robot: Robot, here: FloatArray, rooms: list[str]) -> FloatArray:
+    """``(K, 2, 3)`` boxes a landing UAV keeps off: walls, furniture, people who stay put,
+    the target, the loops walkers go round, and the other robots (a UGV under it in a
+    corridor)."""
+    scene = ctx.sensor.scene
+    boxes = scene.blockers(rooms)
+    walks = [*scene.movers, *scene.avatar_movers(rooms)]
+    target = scene.target
+    if target is not None and target.mover is not None:
+        walks.append(target.mover)
+    elif target is not None:  # nor on the person found (still there)
+        half = np.asarray(target.size) / 2
+        boxes = np.concatenate([boxes, np.array([[np.subtract(target.start, half),
+                                                  np.add(target.start, half)]])])
+    if walks:  # nor on the loop a walker or an obstacle goes round
+        boxes = np.concatenate([boxes, *[_along(m.loop, m.size) for m in walks]])
+    others = [r.position(ctx.env.now) for r in ctx.robots.values() if r is not robot]
+    if others:
+        at = np.array(others)
+        lo = np.column_stack([at[:, :2] - ROBOT_ROOM, np.full(len(at), -1e3)])
+        hi = np.column_stack([at[:, :2] + ROBOT_ROOM, at[:, 2] + 0.5])
+        boxes = np.concatenate([boxes, np.stack([lo, hi], axis=1)])
+    return boxes
+
+
+def _free(boxes: FloatArray, spots: FloatArray, floor: float) -> np.ndarray:
+    """Where the square of floor under each spot (up to the spot) meets none of ``boxes``."""
+    if not len(spots):
+        return np.zeros(0, dtype=bool)
+    lo = np.column_stack([spots[:, :2] - LANDING_CLEAR, np.full(len(spots), floor + 0.02)])
+    hi = np.column_stack([spots[:, :2] + LANDING_CLEAR, spots[:, 2]])
+    near = np.all((boxes[:, 0] < hi.max(axis=0)) & (boxes[:, 1] > lo.min(axis=0)), axis=1)
+    boxes = boxes[near]
+    ok = np.ones(len(spots), dtype=bool)
+    for start in range(0, len(spots), 512):  # in blocks: spots x boxes x 3 stays small
+        a, b = lo[start:start + 512], hi[start:start + 512]
+        hit = np.all((boxes[None, :, 0] < b[:, None]) & (boxes[None, :, 1] > a[:, None]), axis=2)
+        ok[start:start + 512] = ~hit.any(axis=1)
+    return ok
+
+
+def _by_door(ctx: Context, spots: FloatArray, floor: float) -> np.ndarray:
+    """Where a spot is within ``DOOR_KEEP`` of a doorway on ``floor`` (in it, or in front)."""
+    doors = ctx.world.doorways
+    near = np.zeros(len(spots), dtype=bool)
+    mine = doors[np.abs(doors[:, 2] - floor) < 1.0] if len(doors) else doors
+    for start in range(0, len(spots), 512):
+        d = np.linalg.norm(spots[start:start + 512, None, :2] - mine[None, :, :2], axis=2)
+        near[start:start + 512] = (d < DOOR_KEEP).any(axis=1) if len(mine) else False
+    return near
+
+
+def _in(ctx: Context, spot: FloatArray, floor: float, room: Room | None) -> bool:
+    """Is ``spot`` over the same floor, in the same room (or in none, as ``room``)?"""
+    if abs(ctx.world.floor_below(spot) - floor) > 0.05:
+        return False
+    there = ctx.world.room_at((spot[0], spot[1], floor + 0.5))
+    return (there.id if there else None) == (room.id if room else None)
+
+
+def _grid(ctx: Context, here: FloatArray, floor: float, room: Room | None) -> FloatArray:
+    """Spots ``LANDING_GRID`` apart at ``here``'s height: over the room, else within
+    ``LANDING_FAR`` of ``here``, outside every room and over the same floor."""
+    if room is not None:
+        lo = np.asarray(room.box.lo[:2], dtype=float) + LANDING_CLEAR
+        hi = np.asarray(room.box.hi[:2], dtype=float) - LANDING_CLEAR
+    else:
+        lo, hi = here[:2] - LANDING_FAR, here[:2] + LANDING_FAR
+    xs = np.arange(lo[0], hi[0] + 1e-9, LANDING_GRID)
+    ys = np.arange(lo[1], hi[1] + 1e-9, LANDING_GRID)
+    gx, gy = np.meshgrid(xs, ys, indexing="ij")
+    spots = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, here[2])])
+    if room is not None:
+        return spots
+    boxes = ctx.world.room_boxes
+    at = np.column_stack([spots[:, :2], np.full(len(spots), floor + 0.5)])
+    inside = np.zeros(len(spots), dtype=bool)
+    for k in np.flatnonzero(np.all((boxes[:, 0, :2] <= hi) & (boxes[:, 1, :2] >= lo), axis=1)):
+        inside |= np.all((at >= boxes[k, 0]) & (at <= boxes[k, 1]), axis=1)
+    spots = spots[~inside]
+    same = np.array([abs(ctx.world.floor_below(p) - floor) < 0.05 for p in spots], dtype=bool)
+    return spots[same] if len(spots) else spots
+
+
+def _clears(solid: FloatArray, here: FloatArray, spot: FloatArray) -> bool:
+    """Does a UAV flying level from ``here`` to ``spot`` keep its square clear of ``solid``
+    (walls, door jambs, furniture) all the way?"""
+    steps = max(int(np.ceil(float(np.linalg.norm(spot - here)) / 0.1)), 1)
+    pts = here + np.outer(np.linspace(0.0, 1.0, steps + 1), spot - here)
+    lo = np.column_stack([pts[:, :2] - BODY_CLEAR, pts[:, 2] - BODY_BAND])
+    hi = np.column_stack([pts[:, :2] + BODY_CLEAR, pts[:, 2] + BODY_BAND])
+    near = np.all((solid[:, 0] < hi.max(axis=0)) & (solid[:, 1] > lo.min(axis=0)), axis=1)
+    boxes = solid[near]
+    hit = np.all((boxes[None, :, 0] < hi[:, None]) & (boxes[None, :, 1] > lo[:, None]), axis=2)
+    return not bool(hit.any())
+
+
+def _along(loop: FloatArray, size: tuple[float, float, float]) -> FloatArray:
+    """``(K, 2, 3)`` boxes of a body of ``size`` every 0.2 m along its ``loop``."""
+    legs = np.diff(loop, axis=0)
+    steps = np.maximum(np.ceil(np.linalg.norm(legs, axis=1) / 0.2).astype(int), 1)
+    pts = np.vstack([a + np.outer(np.arange(n) / n, leg)
+                     for a, leg, n in zip(loop[:-1], legs, steps, strict=True)])
+    half = np.asarray(size) / 2
+    return np.stack([pts - half, pts + half], axis=1)
+
+
+def land(ctx: Context, robot: Robot) -> StepGen:
+    """A flying UAV comes straight down onto the floor (a ``landed`` event): under it, or
+    beside it where the floor under it is taken (:func:`landing_way`)."""
+    rest = KIND_DEFAULTS[robot.kind].rest
+    if not robot.airborne or rest is None:
+        return 0.0
+    way = landing_way(ctx, robot)
+    distance = 0.0
+    if len(way) > 1:
+        distance = yield from traverse(ctx, robot, way, sense=False)
+    robot.airborne = False  # from here on it is coming down (stopped, it takes off again)
+    distance += yield from climb(ctx, robot, rest)
+    ctx.log.emit("landed", robot.id, position=[round(float(v), 3)
+                                               for v in robot.position(ctx.env.now)])
+    return distance
