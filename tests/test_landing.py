@@ -4,6 +4,7 @@ in physics the landings of the missions that used to fail them now succeed."""
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import numpy as np
@@ -39,8 +40,7 @@ def hovering(sim: Simulation, rid: str, at: tuple[float, float, float]) -> np.nd
 def gap_to_loop(point: np.ndarray, loop: np.ndarray) -> float:
     """The largest of |dx|, |dy| from ``point`` to the nearest point of the loop's legs (the
     square a landing UAV needs meets a walker's box where this is small)."""
-    legs = [a + np.outer(np.linspace(0, 1, 200), b - a) for a, b in zip(loop[:-1], loop[1:],
-                                                                       strict=True)]
+    legs = [a + np.outer(np.linspace(0, 1, 200), b - a) for a, b in itertools.pairwise(loop)]
     pts = np.vstack(legs)[:, :2]
     return float(np.abs(pts - point[:2]).max(axis=1).min())
 

@@ -4,19 +4,16 @@ mechanism with numbers, then the missions themselves."""
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
+import itertools
 
 import numpy as np
 import pytest
+from test_landing import scenario
+from test_local import contacts_between, corridor_mission
 
 from astralis_des.kernel.robot import Motion
 from astralis_des.physics.drivers import ARRIVED
 from astralis_des.physics.local import RADII, SAMPLE, Body, LocalLayer
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_landing import scenario  # noqa: E402
-from test_local import contacts_between, corridor_mission  # noqa: E402
 
 
 def test_a_uav_ducking_through_a_door_does_not_hold_for_a_person_it_will_pass_over() -> None:
@@ -27,8 +24,7 @@ def test_a_uav_ducking_through_a_door_does_not_hold_for_a_person_it_will_pass_ov
     5.48 m, over the head: it does not hold."""
     corners = np.array([[66.0, 79.06], [66.0, 80.02], [65.25, 80.51], [64.5, 81.0]])
     legs = [a + np.outer(np.arange(0, np.linalg.norm(b - a), SAMPLE), (b - a) /
-                         np.linalg.norm(b - a)) for a, b in zip(corners[:-1], corners[1:],
-                                                                 strict=True)]
+                         np.linalg.norm(b - a)) for a, b in itertools.pairwise(corners)]
     route = np.vstack(legs)[:16]
     heights = np.minimum(5.31 + 0.17 * np.arange(16) * SAMPLE / 1.0, 5.48)  # climbing back
     uav = Body("uav1", "uav", route[0], np.array([0.0, 1.0]), (5.21, 5.41), RADII["uav"], 3)

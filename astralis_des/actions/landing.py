@@ -127,10 +127,12 @@ def _by_door(ctx: Context, spots: FloatArray, floor: float) -> np.ndarray:
     """Where a spot is within ``DOOR_KEEP`` of a doorway on ``floor`` (in it, or in front)."""
     doors = ctx.world.doorways
     near = np.zeros(len(spots), dtype=bool)
-    mine = doors[np.abs(doors[:, 2] - floor) < 1.0] if len(doors) else doors
+    if not len(doors):
+        return near
+    mine = doors[np.abs(doors[:, 2] - floor) < 1.0]
     for start in range(0, len(spots), 512):
         d = np.linalg.norm(spots[start:start + 512, None, :2] - mine[None, :, :2], axis=2)
-        near[start:start + 512] = (d < DOOR_KEEP).any(axis=1) if len(mine) else False
+        near[start:start + 512] = (d < DOOR_KEEP).any(axis=1)
     return near
 
 
