@@ -103,3 +103,19 @@ def test_the_landings_that_failed_in_physics_now_succeed(index: int, strategy: s
     landed = {e["robot"] for e in result.events if e["kind"] == "landed"}
     assert landed == {"uav1", "uav2"}
     assert not [e for e in result.events if e["kind"] == "fault"]
+
+
+def test_a_uav_over_the_stairwell_lands_on_a_floor_not_down_the_well() -> None:
+    """Over building A's stair and lift hall on the third floor (x 60-64 m, open from the
+    ground up but for the stair landing) there is no floor to land on: the spot it lands on
+    has a slab's top at the floor's level under its middle and its corners."""
+    sim = scenario(27, "greedy")
+    way = hovering(sim, "uav1", (62.0, 82.0, 8.98))
+    spot = way[-1]
+    solid = sim.world.solid_array
+    tops = solid[np.abs(solid[:, 1, 2] - 7.0) < 0.05]
+    for dx, dy in ((0, 0), (-0.3, -0.3), (-0.3, 0.3), (0.3, -0.3), (0.3, 0.3)):
+        at = spot[:2] + [dx, dy]
+        assert np.any(np.all((at >= tops[:, 0, :2]) & (at <= tops[:, 1, :2]), axis=1))
+    assert not np.any(np.all((np.array([62.0, 82.0]) >= tops[:, 0, :2]) &
+                             (np.array([62.0, 82.0]) <= tops[:, 1, :2]), axis=1))  # the well

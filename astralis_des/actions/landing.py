@@ -1,10 +1,12 @@
 """Landing: where a UAV comes down, and the way there.
 
-A UAV lands where the square of floor under it is free of walls, furniture, other robots and
-the loops that walkers (avatars, moving obstacles) go round; a walker would walk into a UAV
+A UAV lands where there is floor under it (not the stairwell's or the lift's open well) and
+the square of floor under it is free of walls, furniture, the target, other robots and the
+loops that walkers (avatars, moving obstacles) go round; a walker would walk into a UAV
 standing on its loop and tip it over. It looks first on rings around it (the usual case),
-then on a fine grid over its room (a room whose walkers' loop leaves only a strip free), and
-flies to the spot it finds in a straight line its body clears, else by a route.
+then on a fine grid over its room (a room whose walkers' loop leaves only a strip free), then
+round its room's door (the corridor), and flies to the spot it finds in a straight line its
+body clears, else by a route.
 """
 
 from __future__ import annotations
@@ -25,11 +27,14 @@ log = logging.getLogger(__name__)
 LANDING_CLEAR = 0.45  # m: half the side of the square of floor a landing UAV needs free
 LANDING_RINGS = (0.0, 0.6, 1.2, 1.8, 2.4)  # m around a UAV where it looks for that square
 LANDING_GRID = 0.1  # m between the spots of the finer search when no ring has one
-LANDING_FAR = 4.0  # m around a UAV outside any room where the finer search looks
+LANDING_FAR = 4.0  # m around a UAV outside any room (or its room's door) where the
+# finer search looks
 IN_LINE = 400  # the nearest free spots of the finer search tried in a straight line
 ROUTED = 3  # the nearest free spots of the finer search tried by a route, if none is in line
 ROBOT_ROOM = 0.7  # m: half the side of the square another robot takes (the Husky turning)
 DOOR_KEEP = 1.0  # m from a doorway's centre where the finer search lands no UAV
+BODY_FOOT = 0.3  # m: half the side of the square a landed UAV stands on (its radius)
+SUPPORT_Z = 0.05  # m: a slab's top this near a floor's level carries what lands there
 BODY_CLEAR = 0.4  # m: half the side of the square a UAV sweeps flying to its spot
 BODY_BAND = 0.15  # m above and below its height that it sweeps
 
@@ -49,15 +54,18 @@ def landing_way(ctx: Context, robot: Robot) -> FloatArray:
         angles = np.linspace(0.0, 2 * np.pi, 1 if reach == 0 else 12, endpoint=False)
         for angle in angles:
             spot = here + reach * np.array([np.cos(angle), np.sin(angle), 0.0])
-            if _free(taken, spot[None, :], floor)[0] and (reach == 0 or (
+            if _free(taken, spot[None, :], floor)[0] and \
+                    _supported(ctx, spot[None, :], floor)[0] and (reach == 0 or (
                     _in(ctx, spot, floor, room) and bool(scene.line_of_sight(here, spot)[0])
                     and _clears(solid, here, spot))):
                 return np.vstack([here, spot]) if reach else here[None, :]
-    searches = [_grid(ctx, here, floor, room)]
-    if room is not None:  # none in its room: out of it, to the corridor
-        searches.append(_grid(ctx, here, floor, None))
+    searches = [_grid(ctx, here, here, floor, room)]
+    if room is not None:  # none in its room: out of its door, to the corridor
+        door = np.array([*room.door.center[:2], here[2]])
+        searches.append(_grid(ctx, here, door, floor, None))
     for spots in searches:
         spots = spots[_free(taken, spots, floor) & ~_by_door(ctx, spots, floor)]
+        spots = spots[_supported(ctx, spots, floor)]
         way = _nearest_way(ctx, robot, here, spots, solid)
         if way is not None:
             return way
@@ -123,6 +131,21 @@ def _free(boxes: FloatArray, spots: FloatArray, floor: float) -> np.ndarray:
     return ok
 
 
+def _supported(ctx: Context, spots: FloatArray, floor: float) -> np.ndarray:
+    """Where there is floor under a spot: the ground, or the top of a slab at ``floor`` under
+    the middle and the corners of the body (not the stairwell's or the lift's open well)."""
+    ok = np.ones(len(spots), dtype=bool)
+    if floor <= SUPPORT_Z or not len(spots):
+        return ok
+    solid = ctx.world.solid_array
+    tops = solid[np.abs(solid[:, 1, 2] - floor) < SUPPORT_Z]
+    for dx, dy in ((0.0, 0.0), (-1, -1), (-1, 1), (1, -1), (1, 1)):
+        at = spots[:, :2] + np.array([dx, dy]) * BODY_FOOT
+        ok &= np.any(np.all((at[:, None, :] >= tops[None, :, 0, :2]) &
+                            (at[:, None, :] <= tops[None, :, 1, :2]), axis=2), axis=1)
+    return ok
+
+
 def _by_door(ctx: Context, spots: FloatArray, floor: float) -> np.ndarray:
     """Where a spot is within ``DOOR_KEEP`` of a doorway on ``floor`` (in it, or in front)."""
     doors = ctx.world.doorways
@@ -144,14 +167,15 @@ def _in(ctx: Context, spot: FloatArray, floor: float, room: Room | None) -> bool
     return (there.id if there else None) == (room.id if room else None)
 
 
-def _grid(ctx: Context, here: FloatArray, floor: float, room: Room | None) -> FloatArray:
+def _grid(ctx: Context, here: FloatArray, centre: FloatArray, floor: float,
+          room: Room | None) -> FloatArray:
     """Spots ``LANDING_GRID`` apart at ``here``'s height: over the room, else within
-    ``LANDING_FAR`` of ``here``, outside every room and over the same floor."""
+    ``LANDING_FAR`` of ``centre``, outside every room and over the same floor."""
     if room is not None:
         lo = np.asarray(room.box.lo[:2], dtype=float) + LANDING_CLEAR
         hi = np.asarray(room.box.hi[:2], dtype=float) - LANDING_CLEAR
     else:
-        lo, hi = here[:2] - LANDING_FAR, here[:2] + LANDING_FAR
+        lo, hi = centre[:2] - LANDING_FAR, centre[:2] + LANDING_FAR
     xs = np.arange(lo[0], hi[0] + 1e-9, LANDING_GRID)
     ys = np.arange(lo[1], hi[1] + 1e-9, LANDING_GRID)
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
