@@ -63,6 +63,8 @@ def landing_way(ctx: Context, robot: Robot) -> FloatArray:
     if room is not None:  # none in its room: out of its door, to the corridor
         door = np.array([*room.door.center[:2], here[2]])
         searches.append(_grid(ctx, here, door, floor, None))
+    else:  # none near (over the stair hall's well): farther
+        searches.append(_grid(ctx, here, here, floor, None, 2 * LANDING_FAR))
     for spots in searches:
         spots = spots[_free(taken, spots, floor) & ~_by_door(ctx, spots, floor)]
         spots = spots[_supported(ctx, spots, floor)]
@@ -168,14 +170,14 @@ def _in(ctx: Context, spot: FloatArray, floor: float, room: Room | None) -> bool
 
 
 def _grid(ctx: Context, here: FloatArray, centre: FloatArray, floor: float,
-          room: Room | None) -> FloatArray:
+          room: Room | None, far: float = LANDING_FAR) -> FloatArray:
     """Spots ``LANDING_GRID`` apart at ``here``'s height: over the room, else within
-    ``LANDING_FAR`` of ``centre``, outside every room and over the same floor."""
+    ``far`` of ``centre``, outside every room and over the same floor."""
     if room is not None:
         lo = np.asarray(room.box.lo[:2], dtype=float) + LANDING_CLEAR
         hi = np.asarray(room.box.hi[:2], dtype=float) - LANDING_CLEAR
     else:
-        lo, hi = centre[:2] - LANDING_FAR, centre[:2] + LANDING_FAR
+        lo, hi = centre[:2] - far, centre[:2] + far
     xs = np.arange(lo[0], hi[0] + 1e-9, LANDING_GRID)
     ys = np.arange(lo[1], hi[1] + 1e-9, LANDING_GRID)
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
