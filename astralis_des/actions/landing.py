@@ -66,7 +66,8 @@ def landing_way(ctx: Context, robot: Robot) -> FloatArray:
     else:  # none near (over the stair hall's well): farther
         searches.append(_grid(ctx, here, here, floor, None, 2 * LANDING_FAR))
     for spots in searches:
-        spots = spots[_free(taken, spots, floor) & ~_by_door(ctx, spots, floor)]
+        spots = spots[_free(taken, spots, floor) &
+                      ~ctx.world.near_doorway(spots, floor, DOOR_KEEP)]
         spots = spots[_supported(ctx, spots, floor)]
         way = _nearest_way(ctx, robot, here, spots, solid)
         if way is not None:
@@ -146,19 +147,6 @@ def _supported(ctx: Context, spots: FloatArray, floor: float) -> np.ndarray:
         ok &= np.any(np.all((at[:, None, :] >= tops[None, :, 0, :2]) &
                             (at[:, None, :] <= tops[None, :, 1, :2]), axis=2), axis=1)
     return ok
-
-
-def _by_door(ctx: Context, spots: FloatArray, floor: float) -> np.ndarray:
-    """Where a spot is within ``DOOR_KEEP`` of a doorway on ``floor`` (in it, or in front)."""
-    doors = ctx.world.doorways
-    near = np.zeros(len(spots), dtype=bool)
-    if not len(doors):
-        return near
-    mine = doors[np.abs(doors[:, 2] - floor) < 1.0]
-    for start in range(0, len(spots), 512):
-        d = np.linalg.norm(spots[start:start + 512, None, :2] - mine[None, :, :2], axis=2)
-        near[start:start + 512] = (d < DOOR_KEEP).any(axis=1)
-    return near
 
 
 def _in(ctx: Context, spot: FloatArray, floor: float, room: Room | None) -> bool:

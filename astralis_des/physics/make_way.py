@@ -33,14 +33,8 @@ def aside(cosim: Engine, robot: Robot, here: FloatArray, path: FloatArray,
     spots = np.vstack(rings)
     clear_of = RADII[robot.kind] + RADII[asker_kind] + 0.3
     gaps = np.linalg.norm(spots[:, None, :2] - path[None, :, :2], axis=2).min(axis=1)
-    doors = cosim.world.doorways
     floor = cosim.world.floor_below(here - np.array([0.0, 0.0, robot.height]))
-    near_door = np.zeros(len(spots), dtype=bool)
-    if len(doors):
-        mine = doors[np.abs(doors[:, 2] - floor) < 1.0]
-        if len(mine):
-            near_door = np.linalg.norm(spots[:, None, :2] - mine[None, :, :2],
-                                       axis=2).min(axis=1) < DOOR_BUSY
+    near_door = cosim.world.near_doorway(spots, floor, DOOR_BUSY)
     touching = RADII[robot.kind] + RADII[asker_kind]
     for index in np.flatnonzero((gaps >= clear_of) & ~near_door):
         spot = spots[index]

@@ -43,6 +43,15 @@ def facing(valid, state: FloatArray) -> FloatArray:  # type: ignore[no-untyped-d
     return np.asarray(candidates[int(np.argmax(ok))]) if ok.any() else state
 
 
+def rectangle_free(grid: GridMap, states: FloatArray, footprint: tuple[float, float],
+                   clearance: float) -> np.ndarray:
+    """``(N,)``: where a body of ``footprint`` (length, width) at each ``(x, y, heading)``
+    state is clear by ``clearance`` on ``grid`` (the UGV planner's validity test)."""
+    rims = rectangle_points(states, *footprint)
+    return np.asarray(grid.free(rims.reshape(-1, 2), clearance).reshape(len(states), -1)
+                      .all(axis=1))
+
+
 def fits_turned(grid: GridMap, points: FloatArray, footprint: tuple[float, float],
                 clearance: float) -> np.ndarray:
     """``(N,)``: where a body of ``footprint`` (length, width) fits at some heading of
@@ -50,6 +59,5 @@ def fits_turned(grid: GridMap, points: FloatArray, footprint: tuple[float, float
     pts = np.atleast_2d(points)
     states = np.column_stack([np.repeat(pts[:, :2], len(TURNS), axis=0),
                               np.tile(TURNS, len(pts))])
-    rims = rectangle_points(states, *footprint)
-    ok = grid.free(rims.reshape(-1, 2), clearance).reshape(len(states), -1).all(axis=1)
+    ok = rectangle_free(grid, states, footprint, clearance)
     return np.asarray(ok.reshape(len(pts), len(TURNS)).any(axis=1))

@@ -18,7 +18,7 @@ import numpy as np
 
 from astralis_des.errors import InputError
 from astralis_des.kinds import KIND_DEFAULTS
-from astralis_des.planning.footprint import RIM, facing, fits_turned, rectangle_points
+from astralis_des.planning.footprint import RIM, facing, fits_turned, rectangle_free
 from astralis_des.planning.lintels import Lintels
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
@@ -196,13 +196,22 @@ class Navigator(Lintels):
         footprint = KIND_DEFAULTS[robot.kind].footprint
         if footprint is None or not ok.any():
             return ok
-        clearance = self.cfg.margin + RIM / 2
-        reach = (KIND_DEFAULTS[robot.kind].swept_radius or 0.0) + clearance + 2 * CELL
-        for k in np.flatnonzero(ok):
-            floor = self.world.floor_below(pts[k] - np.array([0.0, 0.0, robot.height]))
-            grid = self._floor_grid(pts[k, :2] - reach, pts[k, :2] + reach, floor)
-            ok[k] = bool(fits_turned(grid, pts[k:k + 1], footprint, clearance)[0])
+        reach = (KIND_DEFAULTS[robot.kind].swept_radius or 0.0) + self._rim_clearance + 2 * CELL
+        at = np.flatnonzero(ok)
+        floors = np.array([self.world.floor_below(p - np.array([0.0, 0.0, robot.height]))
+                           for p in pts[at]])
+        for floor in np.unique(floors):  # one grid a floor (it is on the world's lattice)
+            mine = at[floors == floor]
+            grid = self._floor_grid(pts[mine, :2].min(axis=0) - reach,
+                                    pts[mine, :2].max(axis=0) + reach, float(floor))
+            ok[mine] = fits_turned(grid, pts[mine], footprint, self._rim_clearance)
         return ok
+
+    @property
+    def _rim_clearance(self) -> float:
+        """What a long body's rim keeps from what stands on the floor (the grid's cells are
+        checked at the rim's points, ``RIM`` apart)."""
+        return self.cfg.margin + RIM / 2
 
     def prepare(self) -> None:
         """Build the planner's map now rather than on the first route (a server does, so
@@ -338,12 +347,10 @@ class Navigator(Lintels):
             goal = np.array([b[0], b[1], heading])
             footprint = KIND_DEFAULTS["ugv"].footprint
             if footprint is not None:  # the body's rectangle at each state's heading
-                margin = self.cfg.margin
+                clearance = self._rim_clearance
 
                 def valid(states: FloatArray) -> np.ndarray:
-                    points = rectangle_points(states, *footprint)
-                    ok = grid.free(points.reshape(-1, 2), margin + RIM / 2)
-                    return np.asarray(ok.reshape(len(states), -1).all(axis=1))
+                    return rectangle_free(grid, states, footprint, clearance)
             else:
                 def valid(states: FloatArray) -> np.ndarray:
                     return np.asarray(grid.free(states[:, :2], radius))

@@ -82,6 +82,17 @@ class World:
                   for b in self.buildings.values()]
         return np.array(doors, dtype=float).reshape(-1, 4)
 
+    def near_doorway(self, points: FloatArray, floor: float, within: float) -> np.ndarray:
+        """``(N,)``: where a point is within ``within`` (in the plane) of a doorway of the
+        storey at ``floor``."""
+        pts = np.atleast_2d(points)
+        near = np.zeros(len(pts), dtype=bool)
+        doors = self.doorways
+        for door in doors[np.abs(doors[:, 2] - floor) < 1.0]:
+            dx, dy = pts[:, 0] - door[0], pts[:, 1] - door[1]
+            near |= np.sqrt(dx * dx + dy * dy) < within
+        return near
+
     @cached_property
     def router(self) -> Router:
         return Router(self)
