@@ -11,7 +11,8 @@ import pytest
 
 from astralis_des.importers import ImportOptions, import_world
 from astralis_des.importers.ground import find_ground
-from astralis_des.importers.pointcloud import read_las
+from astralis_des.importers.las import read_las
+from astralis_des.importers.source import ReadRequest
 from astralis_des.world.build import load_world
 from astralis_des.world.clutter import place_room
 
@@ -45,7 +46,7 @@ def test_autzen_ground_estimate_agrees_with_its_classification(autzen: Path) -> 
     """Without the classes, the grid estimate's ground share is within 5 points of the
     classification's, four points in five get the same label, and its surface lies within
     5 cm (median) of the classified ground points."""
-    cloud = read_las(autzen)
+    cloud = read_las(autzen, ReadRequest())
     assert cloud.classification is not None
     points = cloud.xyz * 0.3048
     classified = cloud.classification == 2

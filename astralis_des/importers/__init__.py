@@ -14,9 +14,9 @@ import time
 from pathlib import Path
 
 from astralis_des.errors import InputError
-from astralis_des.importers import mesh, pcd, pointcloud  # noqa: F401  (register readers)
+from astralis_des.importers import las, mesh, pcd, pointcloud  # noqa: F401  (register readers)
 from astralis_des.importers.options import ImportOptions, ImportReport
-from astralis_des.importers.source import READERS, Cloud, Mesh, check_file, lookup
+from astralis_des.importers.source import READERS, Cloud, Mesh, ReadRequest, check_file, lookup
 
 __all__ = ["READERS", "ImportOptions", "ImportReport", "formats", "import_world"]
 
@@ -46,7 +46,7 @@ def import_world(source: str | Path, out: str | Path, options: ImportOptions | N
                          key="-o")
     read = lookup(path)
     check_file(path)
-    data = read(path)
+    data = read(path, ReadRequest())
     if isinstance(data, Cloud):
         if len(data.xyz) == 0:
             raise InputError("the cloud has no points", file=path)

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from astralis_des.importers.pointcloud import library_error
-from astralis_des.importers.source import Mesh, reader
+from astralis_des.importers.source import Mesh, ReadRequest, reader
 from astralis_des.importers.voxels import unique_rows, voxel_index
 from astralis_des.world.freespace import FLOOR_TOLERANCE, UP
 from astralis_des.world.geometry import FloatArray
@@ -24,7 +24,7 @@ CHUNK_POINTS = 2_000_000  # surface samples turned into voxels at a time
 
 
 @reader("obj", "stl", "gltf", "glb", memory_per_byte=12.0)
-def read_mesh(path: Path) -> Mesh:
+def read_mesh(path: Path, request: ReadRequest) -> Mesh:
     """One mesh of every part of the file (a scene's parts placed by their transforms)."""
     import trimesh
 

@@ -13,7 +13,7 @@ from typing import BinaryIO
 import numpy as np
 
 from astralis_des.errors import InputError
-from astralis_des.importers.source import Cloud, reader
+from astralis_des.importers.source import Cloud, ReadRequest, reader
 
 HEADER_KEYS = ("VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT",
                "POINTS", "DATA")
@@ -23,7 +23,7 @@ MAX_HEADER_LINES = 64
 
 
 @reader("pcd", memory_per_byte=6.0)
-def read_pcd(path: Path) -> Cloud:
+def read_pcd(path: Path, request: ReadRequest) -> Cloud:
     with path.open("rb") as raw:
         header, line = _header(path, raw)
         data_kind = header["DATA"][0].lower()

@@ -22,15 +22,20 @@ UNITS = {"m": 1.0, "ft": FOOT}
 
 @dataclass
 class Cloud:
-    """Points as read, in the file's units."""
+    """Points as read, in the file's units: ``xyz + ref`` are the file's coordinates (a reader
+    may keep them as float32 offsets from ``ref`` to halve their memory)."""
 
-    xyz: FloatArray  # (N, 3)
+    xyz: FloatArray  # (N, 3), float64 or float32
     classification: NDArray[np.uint8] | None = None  # ASPRS classes, when the file has them
     colors: NDArray[np.uint8] | None = None  # (N, 3)
     crs_scale: float | None = None  # m per horizontal unit, from the file's CRS
     crs_vertical: float | None = None  # m per vertical unit, when the CRS says
     crs_note: str = ""  # where the units came from, for the world file
     crs_wkt: str | None = None  # the file's coordinate system (WKT), when it has one
+    ref: FloatArray = field(default_factory=lambda: np.zeros(3))  # file units
+    resolution: float | None = None  # the file's coordinate step (a LAS scale factor)
+    held: int | None = None  # points the file holds, when more than were kept
+    notes: list[str] = field(default_factory=list)  # what the reader did about the file
 
 
 @dataclass
@@ -44,7 +49,16 @@ class Mesh:
     extra: dict[str, object] = field(default_factory=dict)
 
 
-Reader = Callable[[Path], Cloud | Mesh]
+@dataclass(frozen=True)
+class ReadRequest:
+    """What a reader is asked besides the file."""
+
+    partial: bool = False  # read a truncated file as far as it goes, instead of refusing it
+    max_points: int | None = None  # keep at most this many (evenly); None: what memory allows
+    progress: Callable[[int, int], None] | None = None  # (points read, points in all)
+
+
+Reader = Callable[[Path, ReadRequest], Cloud | Mesh]
 READERS: Registry[str, Reader] = Registry("file format")
 # Bytes of memory a file needs per byte on disk (or per point, for LAS/LAZ) while imported.
 MEMORY_PER_BYTE: dict[str, float] = {}
