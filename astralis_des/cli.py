@@ -6,10 +6,11 @@ Heavy modules are imported inside the commands, so ``astralis --help`` answers a
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -185,10 +186,12 @@ def _add_import_parser(world_sub: Any) -> None:
     imp.add_argument("file", help="the cloud or mesh to import")
     imp.add_argument("-o", "--output", required=True, help="world file to write "
                      "(worlds/NAME.yaml)")
-    imp.add_argument("--units", default="auto", help="auto (the file's CRS, else metres), m "
-                     "or ft")
-    imp.add_argument("--voxel", type=float, default=0.2, help="m, of the blocks and the "
-                     "planner's map (default 0.2)")
+    imp.add_argument("--units", default="auto", help="auto (the file's coordinate system, else "
+                     "guessed and said), m, ft or us-ft")
+    imp.add_argument("--crs", help="the file's coordinate system, over what the file says "
+                     "(EPSG:32617, a WKT or PROJ string): units, and where the world lies")
+    imp.add_argument("--voxel", type=float, help="m, of the blocks and the planner's map "
+                     "(default: a cloud's point spacing, 0.2 to 10; 0.2 for a mesh)")
     imp.add_argument("--ground", default="auto", help="auto (the classification, else grid), "
                      "classification, grid or ransac")
     imp.add_argument("--fill", default="auto", help="columns (aerial: solid down to the "
@@ -204,6 +207,14 @@ def _add_import_parser(world_sub: Any) -> None:
                      help="points kept for the replay (default 50,000)")
     imp.add_argument("--seed", type=int, default=0, help="of RANSAC and downsampling")
     imp.add_argument("--name", help="the world's name (default: the output file's stem)")
+    imp.add_argument("--format", help="read the file as this format (las, laz, pcd, ply, xyz, "
+                     "csv, obj, ...), whatever its extension")
+    imp.add_argument("--partial", action="store_true", help="import the points a truncated "
+                     "file holds, instead of refusing it")
+    imp.add_argument("--max-points", type=int, help="keep at most this many points, evenly "
+                     "(default: what half the free memory holds, at most 50 million)")
+    imp.add_argument("--keep-strays", action="store_true", help="keep points lying far from "
+                     "the rest of the cloud (left out by default, and counted)")
 
 
 WORLD_COMMANDS: dict[str, Command] = {}
@@ -238,34 +249,62 @@ def _world_import(args: argparse.Namespace) -> int:
     from astralis_des.importers import ImportOptions, import_world
 
     options = ImportOptions(
-        units=args.units, voxel=args.voxel, ground=args.ground, fill=args.fill, up=args.up,
-        scale=args.scale, collision=args.collision, areas=args.areas,
+        units=args.units, crs=args.crs, voxel=args.voxel, ground=args.ground, fill=args.fill,
+        up=args.up, scale=args.scale, collision=args.collision, areas=args.areas,
         area_size=args.area_size, margin=args.margin, cloud_points=args.cloud_points,
-        seed=args.seed, name=args.name)
+        seed=args.seed, name=args.name, format=args.format, partial=args.partial,
+        max_points=args.max_points, keep_strays=args.keep_strays)
     command_line = " ".join(["astralis world import", *sys.argv[3:]]) if \
         sys.argv[1:3] == ["world", "import"] else None
-    console = Console(highlight=False)
+    console = Console(highlight=False, stderr=True)
     try:
-        report = import_world(args.file, args.output, options, command=command_line)
+        with _import_progress(console) as progress:
+            report = import_world(args.file, args.output, options, command=command_line,
+                                  progress=progress)
     except KeyboardInterrupt:
         console.print(f"[yellow]interrupted[/]; {args.output} was not written")
         return EXIT_INTERRUPTED
+    out = Console(highlight=False)
     what = (f"{report.points:,} points" if report.kind == "cloud" else
             f"{report.points:,} triangles")
     if report.dropped:
         what += f" ({report.dropped:,} with NaN or infinite coordinates dropped)"
-    console.print(f"[bold]{report.world}[/]: {what} in {report.units}, "
-                  f"site {report.site[0]:g} x {report.site[1]:g} m, {report.blocks:,} blocks, "
-                  f"areas {', '.join(report.areas)} ({report.seconds:.2f} s)")
+    out.print(f"[bold]{report.world}[/]: {what}, site {report.site[0]:g} x "
+              f"{report.site[1]:g} m, voxel {report.voxel:g} m, {report.blocks:,} blocks, "
+              f"areas {', '.join(report.areas)} ({report.seconds:.2f} s)")
+    for note in report.notes:
+        style = "yellow" if note.startswith("warning:") else "dim"
+        out.print(f"[{style}]{note}[/]")
     if report.ground is not None:
         share = f"ground by {report.ground}: {report.ground_share:.1%} of the points"
         if report.classified_share is not None and report.ground != "classification":
             share += f" (the file's classification: {report.classified_share:.1%})"
-        console.print(share)
+        out.print(share)
     if len(report.floors) > 1:
-        console.print("floors at " + ", ".join(f"{z:g}" for z in report.floors) + " m")
-    console.print("wrote " + ", ".join(p.name for p in report.files))
+        out.print("floors at " + ", ".join(f"{z:g}" for z in report.floors) + " m")
+    out.print("wrote " + ", ".join(p.name for p in report.files))
     return 0
+
+
+@contextlib.contextmanager
+def _import_progress(console: Any) -> Iterator[Callable[[int, int], None]]:
+    """A progress bar for the points read, on the terminal only, and from the first million."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    bar = Progress(TextColumn("reading"), BarColumn(), TextColumn("{task.completed:,} of "
+                   "{task.total:,} points"), TimeRemainingColumn(), console=console,
+                   transient=True, disable=not console.is_terminal)
+    task = bar.add_task("read", total=None)
+
+    def update(done: int, total: int) -> None:
+        if total >= 1_000_000:
+            bar.start()
+        bar.update(task, completed=done, total=total)
+
+    try:
+        yield update
+    finally:
+        bar.stop()
 
 
 @world_command("show")

@@ -117,18 +117,19 @@ def test_mesh_without_faces(capsys: pytest.CaptureFixture[str], tmp_path: Path) 
 
 def test_file_larger_than_memory_allows(capsys: pytest.CaptureFixture[str], tmp_path: Path,
                                         monkeypatch: pytest.MonkeyPatch) -> None:
-    """A 100 GB cloud (a sparse file: it takes no disk) is refused before it is read, and so
-    is a LAS whose header announces more points than memory holds."""
+    """A 100 GB text cloud (a sparse file: it takes no disk) is refused before it is read; a
+    LAS with more points than memory holds is thinned evenly to what fits, and says so."""
     with (tmp_path / "huge.xyz").open("wb") as huge:
         huge.truncate(100 * 10**9)
     line = fails(capsys, tmp_path / "huge.xyz", tmp_path)
     assert "a 100,000 MB file needs about 600.0 GB of memory to import" in line
     points, classes = cloud_points()
     las = write_las(tmp_path / "scene.las", points, classes)
-    monkeypatch.setattr(source, "available_memory", lambda: 1e6)
-    line = fails(capsys, las, tmp_path)
-    assert f"a cloud of {len(points):,} points needs about" in line
-    assert line.endswith("0.0 GB is available")
+    monkeypatch.setattr(source, "available_memory", lambda: 5_000 * 2 * 64)  # 5,000 points
+    report = import_world(las, tmp_path / "w" / "twin.yaml")
+    assert report.points == len(points) and report.extra["kept"] == 3_902
+    assert "kept every 4th point (3,902 of 15,605) to stay within --max-points 5,000" in \
+        report.notes
 
 
 @pytest.mark.parametrize("option,value,message", [
@@ -145,12 +146,14 @@ def test_bad_options(capsys: pytest.CaptureFixture[str], tmp_path: Path, option:
     assert message in fails(capsys, las, tmp_path, option, value)
 
 
-def test_voxel_too_fine_for_the_extent(tmp_path: Path) -> None:
-    """A voxel that would need billions of cells is refused with the smallest that works."""
+def test_voxel_too_fine_for_the_cloud(tmp_path: Path) -> None:
+    """A voxel far finer than the points (specks with gaps between them, not walls) is
+    refused with the points' spacing and the finest voxel that works."""
     points, classes = cloud_points()
     las = write_las(tmp_path / "scene.las", points, classes)
-    with pytest.raises(InputError, match=r"--voxel: .* voxels of 0.001 m are too many; pass "
-                                         r"--voxel 0.\d+ or more"):
+    with pytest.raises(InputError, match=r"--voxel: 0.001 m is too fine for this cloud \(one "
+                                         r"point per 0.282 m: 15,605 points .*\): pass "
+                                         r"--voxel 0.029 or more"):
         import_world(las, tmp_path / "worlds" / "twin.yaml", ImportOptions(voxel=0.001))
     assert not (tmp_path / "worlds").exists() or not any((tmp_path / "worlds").iterdir())
 

@@ -11,6 +11,10 @@ classes) is used as classified: ground (2) is the ground, buildings (6) and uncl
 stand as the fill says (an aerial scan's building: a solid from its roof down), vegetation
 (3-5) is canopy kept where its points are (a UAV plans round a crown, a walker passes under
 it), noise (7, 18) is left out.
+
+Everything runs in passes over chunks of the points (:mod:`.survey`), into grids no larger
+than ``MAX_RASTER`` cells and sets of the voxels that hold points: memory follows the points,
+not the extent. The voxel, unless given, follows the points' spacing.
 """
 
 from __future__ import annotations
@@ -20,90 +24,111 @@ import math
 from pathlib import Path
 
 import numpy as np
-from scipy import ndimage
 
 from astralis_des.errors import InputError
-from astralis_des.importers.areas import Area, Level, place_areas
-from astralis_des.importers.ground import GROUND_CLASS, find_ground
+from astralis_des.importers.cloudareas import cloud_areas
+from astralis_des.importers.cloudbuild import build
+from astralis_des.importers.density import SPARSE, choose_voxel, nice_up, raster_cell
+from astralis_des.importers.ground import GROUND_CLASS, Ground, Minima, ground_of
 from astralis_des.importers.options import Built, ImportOptions
-from astralis_des.importers.pointcloud import spacing
-from astralis_des.importers.source import Cloud, finite_rows, unit_scale
-from astralis_des.importers.voxels import (
-    boxes_from_columns,
-    boxes_from_indices,
-    column_tops,
-    grid_shape,
-    unique_rows,
-    voxel_index,
-)
-from astralis_des.world.geometry import FloatArray
+from astralis_des.importers.source import Cloud
+from astralis_des.importers.survey import Survey, survey
+from astralis_des.importers.voxels import MAX_INDEX
 
 log = logging.getLogger(__name__)
 
-VEGETATION_CLASSES = (3, 4, 5)  # ASPRS low, medium, high vegetation: drawn where it is
-NOISE_CLASSES = (7, 18)  # ASPRS low and high noise: left out
-MIN_HEIGHT = 0.3  # m above the ground: lower points are the ground's own clutter (grass, kerbs)
-AREA_HEIGHT = 10.0  # m: an area on the ground is searched up to this height
-CLEARANCE = 1.0  # m kept between an area and the nearest block
-MAX_CLOSE = 5  # cells of grey closing at most
-SEEN_CELL = 2.0  # m: ground counts as seen by the scan in cells of this size holding points
+FINEST = 10  # a voxel finer than a tenth of the points' spacing makes specks, not walls
 
 
-def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions) -> Built:
-    finite = finite_rows(cloud.xyz)
-    dropped = int(len(finite) - finite.sum())
-    if dropped:
-        log.warning("%s: dropped %d points with NaN or infinite coordinates", path, dropped)
-    if not finite.any():
-        raise InputError(f"no point has finite coordinates ({dropped:,} dropped)", file=path)
-    xyz = cloud.xyz[finite] if dropped else cloud.xyz
-    classes = cloud.classification[finite] if (
-        cloud.classification is not None and dropped) else cloud.classification
-    colors = cloud.colors[finite] if cloud.colors is not None and dropped else cloud.colors
-    scale = unit_scale(opts.units, cloud.crs_scale) * opts.scale
-    vertical = (cloud.crs_vertical if opts.units == "auto" and cloud.crs_vertical else
-                unit_scale(opts.units, cloud.crs_scale)) * opts.scale
-    points = xyz * np.array([scale, scale, vertical])
-    del xyz
-    rng = np.random.default_rng(opts.seed)
+def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions, fmt: str) -> Built:
+    """The world of ``cloud`` (read from ``path``, a ``fmt`` file)."""
     try:
-        ground = find_ground(points, classes, opts.ground, rng)
-    except ValueError as exc:
-        raise InputError(str(exc), file=path, key="--ground") from None
-    height = points[:, 2] - ground.height(points)
-    origin = points[:, :2].min(axis=0) - opts.margin
-    local = points[:, :2] - origin
-    del points
-    extent = local.max(axis=0) + opts.margin
-    shape = grid_shape(extent, opts.voxel, what="the cloud")
-    site = (shape[0] * opts.voxel, shape[1] * opts.voxel)
-    standing = ~ground.mask & (height > MIN_HEIGHT)
-    canopy = np.zeros(len(standing), dtype=bool)
-    if classes is not None:  # ASPRS classes: noise left out; vegetation is canopy (below)
-        standing &= ~np.isin(classes, NOISE_CLASSES)
-        canopy = standing & np.isin(classes, VEGETATION_CLASSES)
-    fill = opts.fill if opts.fill != "auto" else (
-        "columns" if path.suffix.lower() in (".las", ".laz") else "none")
-    boxes, blocked = _blocks(local, height, standing & ~canopy, shape, opts.voxel, fill)
-    if canopy.any():  # only where its points are: a walker passes under a tree's crown
-        crown, under = _blocks(local, height, canopy, shape, opts.voxel, "none")
-        boxes, blocked = np.concatenate([boxes, crown]), blocked | under
-    areas = _areas(local, blocked, shape, opts)
-    sample = _sample(len(local), opts.cloud_points, rng)
-    cloud_xyz = np.column_stack([local[sample], height[sample]]).astype(np.float32)
-    cloud_rgb = colors[sample] if colors is not None else None
-    classified = float(np.mean(classes == GROUND_CLASS)) if classes is not None else None
-    offset = (float(origin[0] / scale), float(origin[1] / scale),
-              float(np.median(ground.heights) / vertical))
-    source = {"kind": "cloud", "points": len(finite), "dropped": dropped,
-              "units": _units_note(opts, cloud, scale), "scale": round(scale, 9), "up": "z",
-              "offset": offset, "ground": ground.method,
-              "ground_share": round(ground.share, 4), "relief": round(ground.relief, 2),
-              "origin": _geodetic(cloud.crs_wkt, offset, vertical)}
-    stats = {"ground_share": ground.share, "classified_share": classified, "fill": fill,
-             "standing": int(standing.sum()), "canopy": int(canopy.sum())}
-    return Built("cloud", site, opts.voxel, boxes, areas, source, "boxes",
-                 floors=[0.0], cloud=cloud_xyz, cloud_colors=cloud_rgb, stats=stats)
+        found = survey(cloud, opts.units, opts.crs, opts.scale, opts.keep_strays)
+    except InputError as exc:
+        raise InputError(exc.message, file=path, key=exc.key) from None
+    notes = [*cloud.notes, f"units: {found.metres.frame.note}", *found.notes]
+    voxel = _voxel(found, opts, path, notes)
+    rng = np.random.default_rng(opts.seed)
+    ground = _ground(cloud, found, opts, path, rng)
+    origin = found.lo[:2] - opts.margin
+    extent = found.hi[:2] - origin + opts.margin
+    shape = (max(math.ceil(float(extent[0]) / voxel - 1e-9), 1),
+             max(math.ceil(float(extent[1]) / voxel - 1e-9), 1))
+    fill = opts.fill if opts.fill != "auto" else ("columns" if fmt in ("las", "laz") else
+                                                  "none")
+    built = build(cloud, found, ground, origin, shape, voxel, fill, opts, rng)
+    areas = cloud_areas(built, shape, voxel, found, opts, path, notes)
+    frame = found.metres.frame
+    file_xy = frame.file_xy(origin if frame.projection is None else origin / opts.scale)
+    offset = (file_xy[0], file_xy[1], float(np.median(ground.heights) / frame.vertical))
+    classified = found.ground_class / found.kept if cloud.classification is not None else None
+    share = built.ground_points / found.kept
+    source = {"kind": "cloud", "points": len(cloud) if cloud.held is None else cloud.held,
+              "dropped": found.dropped, "units": frame.note, "scale": round(frame.horizontal,
+                                                                           9),
+              "up": "z", "offset": offset, "ground": ground.method,
+              "ground_share": round(share, 4), "relief": round(ground.relief, 2),
+              "origin": _geodetic(frame.wkt, offset, frame.vertical)}
+    if found.strays:
+        source["strays"] = found.strays
+    if cloud.held is not None and cloud.held != len(cloud):
+        source["kept"] = len(cloud)
+    stats = {"ground_share": share, "classified_share": classified, "fill": fill,
+             "standing": built.standing, "canopy": built.canopy, "spacing": found.spacing,
+             "kept": found.kept, "strays": found.strays}
+    return Built("cloud", (shape[0] * voxel, shape[1] * voxel), voxel, built.boxes, areas,
+                 source, "boxes", floors=[0.0], cloud=built.cloud, cloud_colors=built.colors,
+                 stats=stats, notes=notes)
+
+
+def _voxel(found: Survey, opts: ImportOptions, path: Path, notes: list[str]) -> float:
+    """The voxel: as given (unless far finer than the points, or too fine for the site), else
+    the finest nice size no finer than the points' spacing."""
+    span = float(np.max(found.hi[:2] - found.lo[:2])) + 2 * opts.margin
+    coarsest = span / MAX_INDEX  # boxes are stored as uint16 voxel indices
+    spaced = (f"one point per {found.spacing:.3g} m: {found.kept:,} points over the "
+              f"{found.area:,.0f} m^2 they cover")
+    if opts.voxel is not None:
+        smallest = max(found.spacing / FINEST, coarsest)
+        if opts.voxel < smallest:
+            raise InputError(f"{opts.voxel:g} m is too fine for this cloud ({spaced}; the "
+                             f"site spans {span:,.0f} m): pass --voxel "
+                             f"{math.ceil(smallest * 1000) / 1000:g} or more", file=path,
+                             key="--voxel")
+        return float(opts.voxel)
+    voxel = choose_voxel(max(found.spacing, coarsest))
+    if coarsest > voxel:
+        raise InputError(f"the cloud spans {span / 1000:,.0f} km ({found.kept:,} points): "
+                         f"more than a world holds at {voxel:g} m voxels (65,535 a side); "
+                         "crop it first", file=path)
+    how = "the finest no finer than the points" if voxel >= found.spacing else \
+        "the coarsest, though the points lie further apart"
+    notes.append(f"voxel {voxel:g} m, {how} ({spaced}); --voxel to choose")
+    if found.spacing > SPARSE:
+        notes.append(f"warning: a sparse cloud, so a coarse world: {spaced}; blocks stand "
+                     "only where points are")
+    return voxel
+
+
+def _ground(cloud: Cloud, found: Survey, opts: ImportOptions, path: Path,
+            rng: np.random.Generator) -> Ground:
+    method = opts.ground
+    if method == "auto":
+        method = "classification" if found.ground_class else "grid"
+    if method == "classification" and not found.ground_class:
+        raise InputError("the cloud has no points classified as ground (class 2)", file=path,
+                         key="--ground")
+    cell = 1.0 if found.spacing <= 1.0 else nice_up(found.spacing)
+    cell = raster_cell(cell, found.hi[:2] - found.lo[:2])
+    index = np.floor((found.hi[:2] - found.lo[:2]) / cell).astype(np.int64)
+    minima = Minima(found.lo[:2], cell, (int(index[0]) + 1, int(index[1]) + 1))
+    classes = cloud.classification
+    for lo, hi, m in found.metres.chunks():
+        keep = found.keep[lo:hi]
+        mask = classes[lo:hi][keep] == GROUND_CLASS if method == "classification" and \
+            classes is not None else None
+        minima.add(m[keep], mask)
+    return ground_of(minima, method, rng)
 
 
 def _geodetic(wkt: str | None, offset: tuple[float, float, float],
@@ -126,56 +151,3 @@ def _geodetic(wkt: str | None, offset: tuple[float, float, float],
         return None
     return {"latitude": round(float(lat), 7), "longitude": round(float(lon), 7),
             "altitude": round(offset[2] * vertical, 3)}
-
-
-def _units_note(opts: ImportOptions, cloud: Cloud, scale: float) -> str:
-    if opts.units != "auto":
-        return f"{opts.units} (given)"
-    if cloud.crs_scale is not None:
-        return cloud.crs_note
-    return "m (no CRS in the file: metres assumed)"
-
-
-def _blocks(xy: FloatArray, height: FloatArray, standing: np.ndarray, shape: tuple[int, ...],
-            voxel: float, fill: str) -> tuple[np.ndarray, np.ndarray]:
-    """Merged boxes of what stands on the ground, and the ``(nx, ny)`` cells blocked below
-    ``AREA_HEIGHT``."""
-    cells = np.floor(xy[standing] / voxel).astype(np.int64)
-    cells = np.minimum(cells, np.array(shape[:2]) - 1)
-    if fill == "columns":
-        close = min(max(math.ceil(spacing(xy) / voxel), 1), MAX_CLOSE)
-        tops = column_tops(cells, height[standing], (shape[0], shape[1]), voxel, close)
-        return boxes_from_columns(tops), tops > 0
-    index = unique_rows(np.column_stack([cells, voxel_index(height[standing][:, None],
-                                                            voxel)[:, 0]]))
-    blocked = np.zeros(shape[:2], dtype=bool)
-    low = index[index[:, 2] * voxel < AREA_HEIGHT]
-    blocked[low[:, 0], low[:, 1]] = True
-    return boxes_from_indices(index), blocked
-
-
-def _areas(xy: FloatArray, blocked: np.ndarray, shape: tuple[int, ...],
-           opts: ImportOptions) -> list[Area]:
-    """Areas on ground the scan saw (``SEEN_CELL`` cells holding points, small gaps closed),
-    clear of blocks by ``CLEARANCE``."""
-    if opts.areas == 0:
-        return []
-    coarse = max(SEEN_CELL, opts.voxel)
-    cells = np.floor(xy / coarse).astype(np.int64)
-    seen = np.zeros(tuple(int(n) for n in cells.max(axis=0) + 1), dtype=bool)
-    seen[cells[:, 0], cells[:, 1]] = True
-    seen = ndimage.binary_closing(seen, np.ones((3, 3), dtype=bool))
-    centre = ((np.indices(shape[:2]) + 0.5) * opts.voxel / coarse).astype(np.int64)
-    inside = (centre[0] < seen.shape[0]) & (centre[1] < seen.shape[1])
-    seen_fine = np.zeros(shape[:2], dtype=bool)
-    seen_fine[inside] = seen[centre[0][inside], centre[1][inside]]
-    clear = max(math.ceil(CLEARANCE / opts.voxel), 1)
-    near = ndimage.maximum_filter(blocked, size=2 * clear + 1)  # a square dilation, separable
-    return place_areas([Level(0.0, seen_fine & ~near)], opts.voxel, opts.areas,
-                       opts.area_size, lambda z, si, sj: AREA_HEIGHT)
-
-
-def _sample(n: int, keep: int, rng: np.random.Generator) -> np.ndarray:
-    if keep >= n:
-        return np.arange(n)
-    return np.sort(rng.choice(n, size=keep, replace=False))

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 
+from astralis_des.importers.sparse import keyed
 from astralis_des.registry import Registry
 from astralis_des.world.geometry import FloatArray
 
@@ -40,13 +41,14 @@ GROUND_CLASS = 2  # ASPRS LAS classification
 
 @dataclass(frozen=True)
 class Ground:
-    """Ground points and the ground surface ``z = height(x, y)``, on a grid or a plane."""
+    """The ground surface ``z = height(x, y)`` on a grid (a plane for RANSAC), and which
+    points are ground."""
 
     method: str
-    mask: NDArray[np.bool_]  # (N,) true for ground points
     origin: FloatArray  # (2,) corner of the grid
     cell: float
     heights: FloatArray  # (nx, ny) ground height of each cell's centre
+    plane: tuple[float, float, float] | None = None  # z = a x + b y + c (ransac)
 
     def height(self, xy: FloatArray) -> FloatArray:
         """Bilinear ground height at each ``(x, y)``; the edge value beyond the grid."""
@@ -54,9 +56,18 @@ class Ground:
         return np.asarray(ndimage.map_coordinates(self.heights, [u[:, 0], u[:, 1]], order=1,
                                                   mode="nearest"))
 
-    @property
-    def share(self) -> float:
-        return float(self.mask.mean()) if len(self.mask) else 0.0
+    def is_ground(self, xyz: FloatArray, classification: NDArray[np.uint8] | None
+                  ) -> NDArray[np.bool_]:
+        """``(N,)``: the points of class 2 (``classification``), within ``RANSAC_TOLERANCE``
+        of the plane (``ransac``), or on the surface's lower envelope (``grid``)."""
+        if self.method == "classification":
+            assert classification is not None
+            return np.asarray(classification == GROUND_CLASS)
+        if self.plane is not None:
+            a, b, c = self.plane
+            return np.asarray(np.abs(xyz[:, 2] - (a * xyz[:, 0] + b * xyz[:, 1] + c))
+                              <= RANSAC_TOLERANCE)
+        return np.asarray(xyz[:, 2] <= self.height(xyz) + TOLERANCE)
 
     @property
     def relief(self) -> float:
@@ -66,38 +77,59 @@ class Ground:
         return float(hi - lo)
 
 
-Method = Callable[[FloatArray, "NDArray[np.uint8] | None", np.random.Generator], Ground]
+class Minima:
+    """The lowest z of each cell of a grid (``inf`` where none), folded in chunk by chunk."""
+
+    def __init__(self, origin: FloatArray, cell: float, shape: tuple[int, int]) -> None:
+        self.origin, self.cell = np.asarray(origin, dtype=float), cell
+        self.lowest = np.full(shape, np.inf)
+
+    def add(self, xyz: FloatArray, mask: NDArray[np.bool_] | None = None) -> None:
+        pick = xyz if mask is None else xyz[mask]
+        if not len(pick):
+            return
+        index = np.floor((pick[:, :2] - self.origin) / self.cell).astype(np.int64)
+        np.clip(index, 0, np.array(self.lowest.shape) - 1, out=index)
+        flat = index[:, 0] * self.lowest.shape[1] + index[:, 1]
+        keys, low = keyed(flat, pick[:, 2], "min")
+        view = self.lowest.reshape(-1)
+        view[keys] = np.minimum(view[keys], low)
+
+
+Method = Callable[[Minima, np.random.Generator], Ground]
 METHODS: Registry[str, Method] = Registry("ground method")
 
 
 def find_ground(xyz: FloatArray, classification: NDArray[np.uint8] | None, method: str,
-                rng: np.random.Generator) -> Ground:
-    """The ground by ``method`` (``auto``: the classification when it has ground points,
-    else the grid minimum)."""
+                rng: np.random.Generator, cell: float = CELL) -> Ground:
+    """The ground of a whole cloud by ``method`` (``auto``: the classification when it has
+    ground points, else the grid minimum); :func:`ground_of` for a cloud seen in chunks."""
     if method == "auto":
         has_class = classification is not None and bool(np.any(classification == GROUND_CLASS))
         method = "classification" if has_class else "grid"
-    ground = METHODS.get(method)(xyz, classification, rng)
-    log.info("ground by %s: %.1f%% of the points, relief %.1f m", ground.method,
-             100 * ground.share, ground.relief)
+    origin = xyz[:, :2].min(axis=0)
+    shape = grid_shape(xyz[:, :2].max(axis=0), origin, cell)
+    minima = Minima(origin, cell, shape)
+    if method == "classification":
+        if classification is None or not np.any(classification == GROUND_CLASS):
+            raise ValueError("the cloud has no points classified as ground (class 2)")
+        minima.add(xyz, classification == GROUND_CLASS)
+    else:
+        minima.add(xyz)
+    return ground_of(minima, method, rng)
+
+
+def grid_shape(hi: FloatArray, origin: FloatArray, cell: float) -> tuple[int, int]:
+    index = np.floor((np.asarray(hi) - origin) / cell).astype(np.int64)
+    return int(index[0]) + 1, int(index[1]) + 1
+
+
+def ground_of(minima: Minima, method: str, rng: np.random.Generator) -> Ground:
+    """The ground by ``method`` from the cells' lowest points (of the ground class, for
+    ``classification``)."""
+    ground = METHODS.get(method)(minima, rng)
+    log.info("ground by %s, relief %.1f m", ground.method, ground.relief)
     return ground
-
-
-def _cells(xy: FloatArray, origin: FloatArray) -> tuple[NDArray[np.int64], tuple[int, int]]:
-    index = np.floor((xy - origin) / CELL).astype(np.int64)
-    shape = (int(index[:, 0].max()) + 1, int(index[:, 1].max()) + 1)
-    return index, shape
-
-
-def _minima(xyz: FloatArray, index: NDArray[np.int64], shape: tuple[int, int]) -> FloatArray:
-    """Lowest z of each cell (inf where empty), by sorting: ``minimum.at`` is slower."""
-    flat = index[:, 0] * shape[1] + index[:, 1]
-    order = np.lexsort((xyz[:, 2], flat))
-    first = np.ones(len(order), dtype=bool)
-    first[1:] = flat[order][1:] != flat[order][:-1]
-    lowest = np.full(shape[0] * shape[1], np.inf)
-    lowest[flat[order][first]] = xyz[order[first], 2]
-    return lowest.reshape(shape)
 
 
 def _filled(lowest: FloatArray) -> FloatArray:
@@ -105,65 +137,47 @@ def _filled(lowest: FloatArray) -> FloatArray:
     empty = ~np.isfinite(lowest)
     if not empty.any():
         return lowest
+    if empty.all():
+        return np.zeros_like(lowest)
     index = ndimage.distance_transform_edt(empty, return_distances=False, return_indices=True)
     return np.asarray(lowest[tuple(index)])
 
 
-def _surface(xyz: FloatArray, mask: NDArray[np.bool_] | None) -> tuple[FloatArray, FloatArray]:
-    """Origin and grid minimum of the points (of ``mask``), empty cells filled."""
-    origin = xyz[:, :2].min(axis=0)
-    index, shape = _cells(xyz[:, :2], origin)
-    pick = slice(None) if mask is None else mask
-    return origin, _filled(_minima(xyz[pick], index[pick], shape))
-
-
-def _objects(surface: FloatArray) -> NDArray[np.bool_]:
+def _objects(surface: FloatArray, cell: float) -> NDArray[np.bool_]:
     """Cells of the minimum surface that openings of growing windows lower by more than the
     terrain's ``SLOPE`` allows: what stands on the ground."""
     objects = np.zeros(surface.shape, dtype=bool)
-    for radius in range(1, max(round(WINDOW / CELL / 2), 1) + 1):
+    for radius in range(1, max(round(WINDOW / cell / 2), 1) + 1):
         opened = ndimage.grey_opening(surface, size=(2 * radius + 1, 2 * radius + 1))
-        objects |= surface - opened > SLOPE * radius * CELL
+        objects |= surface - opened > SLOPE * radius * cell
     return objects
 
 
 @METHODS.register("classification")
-def by_classification(xyz: FloatArray, classification: NDArray[np.uint8] | None,
-                      rng: np.random.Generator) -> Ground:
-    if classification is None or not np.any(classification == GROUND_CLASS):
-        raise ValueError("the cloud has no points classified as ground (class 2)")
-    mask = classification == GROUND_CLASS
-    origin, heights = _surface(xyz, mask)
-    return Ground("classification", mask, origin, CELL, heights)
+def by_classification(minima: Minima, rng: np.random.Generator) -> Ground:
+    return Ground("classification", minima.origin, minima.cell, _filled(minima.lowest))
 
 
 @METHODS.register("grid")
-def by_grid_minimum(xyz: FloatArray, classification: NDArray[np.uint8] | None,
-                    rng: np.random.Generator) -> Ground:
-    origin, lowest = _surface(xyz, None)
-    objects = _objects(lowest)
+def by_grid_minimum(minima: Minima, rng: np.random.Generator) -> Ground:
+    lowest = _filled(minima.lowest)
+    objects = _objects(lowest, minima.cell)
     heights = _filled(np.where(objects, np.inf, lowest)) if not objects.all() else lowest
-    ground = Ground("grid", np.zeros(len(xyz), dtype=bool), origin, CELL, heights)
-    mask = xyz[:, 2] <= ground.height(xyz) + TOLERANCE
-    return Ground("grid", mask, origin, CELL, heights)
+    return Ground("grid", minima.origin, minima.cell, heights)
 
 
 @METHODS.register("ransac")
-def by_ransac_plane(xyz: FloatArray, classification: NDArray[np.uint8] | None,
-                    rng: np.random.Generator) -> Ground:
-    origin = xyz[:, :2].min(axis=0)
-    index, shape = _cells(xyz[:, :2], origin)
-    lowest = _minima(xyz, index, shape)
+def by_ransac_plane(minima: Minima, rng: np.random.Generator) -> Ground:
+    origin, cell, lowest = minima.origin, minima.cell, minima.lowest
     ci, cj = np.nonzero(np.isfinite(lowest))
-    seeds = np.column_stack([origin[0] + (ci + 0.5) * CELL, origin[1] + (cj + 0.5) * CELL,
+    seeds = np.column_stack([origin[0] + (ci + 0.5) * cell, origin[1] + (cj + 0.5) * cell,
                              lowest[ci, cj]])
     plane = _ransac_plane(seeds, rng)
     a, b, c = plane  # z = a x + b y + c
-    gx = origin[0] + (np.arange(shape[0]) + 0.5) * CELL
-    gy = origin[1] + (np.arange(shape[1]) + 0.5) * CELL
+    gx = origin[0] + (np.arange(lowest.shape[0]) + 0.5) * cell
+    gy = origin[1] + (np.arange(lowest.shape[1]) + 0.5) * cell
     heights = a * gx[:, None] + b * gy[None, :] + c
-    mask = np.abs(xyz[:, 2] - (a * xyz[:, 0] + b * xyz[:, 1] + c)) <= TOLERANCE
-    return Ground("ransac", mask, origin, CELL, heights)
+    return Ground("ransac", origin, cell, heights, plane)
 
 
 def _ransac_plane(points: FloatArray, rng: np.random.Generator) -> tuple[float, float, float]:

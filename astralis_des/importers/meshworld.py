@@ -38,10 +38,12 @@ HEADROOM = 2.0  # m of clear height an area's floor needs
 AREA_HEIGHT = 10.0  # m: the most an area reaches above its floor
 MIN_AREA_HEIGHT = 2.5
 AREA_LEVELS = 8  # the floors with the most area that search areas may be placed on
+MESH_VOXEL = 0.2  # m, unless --voxel says
 VHACD_RESOLUTION = 50_000  # voxels of V-HACD's decomposition (its default, 100,000, is slower)
 
 
 def mesh_world(mesh: Mesh, path: Path, opts: ImportOptions) -> Built:
+    voxel = opts.voxel or MESH_VOXEL
     good = finite_rows(mesh.vertices)
     dropped = int(len(good) - good.sum())
     faces = mesh.faces[good[mesh.faces].all(axis=1)] if dropped else mesh.faces
@@ -58,19 +60,19 @@ def mesh_world(mesh: Mesh, path: Path, opts: ImportOptions) -> Built:
     vertices = turned - origin
     tri = triangles(vertices, faces)
     extent = vertices[used].max(axis=0) + np.array([opts.margin, opts.margin, 0.0])
-    shape = grid_shape(extent + opts.voxel, opts.voxel, what="the mesh")
-    cells = surface_voxels(tri, opts.voxel)
+    shape = grid_shape(extent + voxel, voxel, what="the mesh")
+    cells = surface_voxels(tri, voxel)
     closed = np.ones(len(faces), dtype=bool) if mesh.watertight else \
         closed_faces(vertices, faces)
     if closed.any():  # the insides of closed parts are solid too
-        cells = unique_rows(np.vstack([cells, _inside(surface_voxels(tri[closed], opts.voxel),
+        cells = unique_rows(np.vstack([cells, _inside(surface_voxels(tri[closed], voxel),
                                                       shape)]))
     cells = cells[cells[:, 2] >= 0]  # a surface at z = 0 lies on the ground plane
     boxes = boxes_from_indices(cells)
     found = floor_levels(tri)
     levels = sorted({0.0, *(z for z, _ in found)})
     widest = sorted(z for z, _ in sorted(found, key=lambda f: -f[1])[:AREA_LEVELS])
-    areas = _areas(tri, cells, sorted({0.0, *widest}), shape, opts)
+    areas = _areas(tri, cells, sorted({0.0, *widest}), shape, voxel, opts)
     collision = opts.collision if opts.collision != "auto" else "concave"
     parts = _convex_parts(vertices, faces) if collision == "convex" else None
     back = _to_source(origin / scale, up)
@@ -78,10 +80,12 @@ def mesh_world(mesh: Mesh, path: Path, opts: ImportOptions) -> Built:
               "units": f"{opts.units} (given)" if opts.units != "auto" else
               "m (a mesh has no units: metres assumed)", "scale": round(scale, 9), "up": up,
               "offset": back}
-    site = (shape[0] * opts.voxel, shape[1] * opts.voxel)
-    return Built("mesh", site, opts.voxel, boxes, areas, source, collision,
+    site = (shape[0] * voxel, shape[1] * voxel)
+    return Built("mesh", site, voxel, boxes, areas, source, collision,
                  floors=levels, vertices=vertices, faces=faces, parts=parts,
-                 stats={"watertight": mesh.watertight, "surface_voxels": len(cells)})
+                 stats={"watertight": mesh.watertight, "surface_voxels": len(cells),
+                        "extent": tuple(float(v) for v in vertices[used].max(axis=0) -
+                                        vertices[used].min(axis=0))})
 
 
 def _to_source(origin: FloatArray, up: str) -> tuple[float, float, float]:
@@ -101,11 +105,11 @@ def _inside(cells: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
 
 
 def _areas(tri: FloatArray, cells: np.ndarray, levels: list[float], shape: tuple[int, ...],
-           opts: ImportOptions) -> list[Area]:
+           voxel: float, opts: ImportOptions) -> list[Area]:
     """Areas on each floor where nothing stands in the ``HEADROOM`` above it."""
     if opts.areas == 0:
         return []
-    v = opts.voxel
+    v = voxel
     plan = (shape[0], shape[1])
     found = []
     for z in levels:

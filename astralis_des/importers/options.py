@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 
 from astralis_des.errors import InputError
 from astralis_des.importers.areas import Area
+from astralis_des.importers.source import UNITS
 from astralis_des.world.geometry import FloatArray
 
 FILLS = ("auto", "columns", "none")
@@ -23,8 +24,9 @@ GROUNDS = ("auto", "classification", "grid", "ransac")
 
 @dataclass(frozen=True)
 class ImportOptions:
-    units: str = "auto"  # auto (the file's CRS, else metres) | m | ft
-    voxel: float = 0.2  # m
+    units: str = "auto"  # auto (the file's CRS, else guessed) | m | ft | us-ft
+    crs: str | None = None  # the file's coordinate system, over what the file says
+    voxel: float | None = None  # m; None: from the points' spacing (clouds), 0.2 (meshes)
     ground: str = "auto"  # auto | classification | grid | ransac (clouds)
     fill: str = "auto"  # columns | none | auto: columns for LAS/LAZ (aerial), none otherwise
     up: str = "auto"  # the file's up axis (meshes): auto | y | z
@@ -36,6 +38,10 @@ class ImportOptions:
     cloud_points: int = 50_000  # points kept for the replay
     seed: int = 0  # of every random draw (RANSAC, downsampling)
     name: str | None = None  # the world's name; default: the output file's stem
+    format: str | None = None  # read the file as this format, whatever its extension
+    partial: bool = False  # import what a truncated file holds
+    max_points: int | None = None  # keep at most this many points (evenly); None: by memory
+    keep_strays: bool = False  # keep points far from the rest of the cloud
 
     def check(self) -> None:
         """Refuse nonsense at the edge, naming the option."""
@@ -43,16 +49,20 @@ class ImportOptions:
             if not ok:
                 raise InputError(message, key=key)
 
-        for key, value, valid in (("--units", self.units, ("auto", "m", "ft")),
+        for key, value, valid in (("--units", self.units, ("auto", *UNITS)),
                                   ("--ground", self.ground, GROUNDS),
                                   ("--fill", self.fill, FILLS), ("--up", self.up, UPS),
                                   ("--collision", self.collision, COLLISIONS)):
             need(value in valid, key, f"'{value}' is not one of: {', '.join(valid)}")
         for key, number in (("--voxel", self.voxel), ("--scale", self.scale),
                             ("--area-size", self.area_size)):
-            need(math.isfinite(number) and number > 0, key, f"must be a positive number, "
-                 f"got {number:g}")
-        need(self.voxel <= 10.0, "--voxel", f"{self.voxel:g} m is coarser than 10 m")
+            if number is not None:
+                need(math.isfinite(number) and number > 0, key,
+                     f"must be a positive number, got {number:g}")
+        if self.voxel is not None:
+            need(self.voxel <= 10.0, "--voxel", f"{self.voxel:g} m is coarser than 10 m")
+        need(self.max_points is None or self.max_points >= 1, "--max-points",
+             "must be at least 1")
         need(math.isfinite(self.margin) and self.margin >= 0, "--margin",
              f"must be 0 or more, got {self.margin:g}")
         need(self.areas >= 0, "--areas", f"must be 0 or more, got {self.areas}")
@@ -78,6 +88,7 @@ class Built:
     cloud: NDArray[np.float32] | None = None  # (N, 3), world frame
     cloud_colors: NDArray[np.uint8] | None = None
     stats: dict[str, Any] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)  # what was chosen, guessed or left out
 
 
 @dataclass(frozen=True)
@@ -100,3 +111,5 @@ class ImportReport:
     classified_share: float | None = None  # class 2 in the file, when it says
     seconds: float = 0.0
     extra: dict[str, Any] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()  # what was chosen, guessed or left out, a line each
+    voxel: float = 0.0

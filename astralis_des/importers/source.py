@@ -4,9 +4,11 @@ passes before a reader sees it, and the registry of readers by file extension.""
 from __future__ import annotations
 
 import os
+import stat
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,25 +19,37 @@ from astralis_des.world.geometry import FloatArray
 
 FOOT = 0.3048  # m, the international foot
 US_SURVEY_FOOT = 1200 / 3937  # m
-UNITS = {"m": 1.0, "ft": FOOT}
+UNITS = {"m": 1.0, "ft": FOOT, "us-ft": US_SURVEY_FOOT}
 
 
 @dataclass
 class Cloud:
-    """Points as read, in the file's units: ``xyz + ref`` are the file's coordinates (a reader
-    may keep them as float32 offsets from ``ref`` to halve their memory)."""
+    """Points as read: the file's coordinates are ``xyz * step + ref``. A LAS reader keeps the
+    file's own integers with its scale and offset (12 bytes a point, exact); other readers keep
+    floats, with a step of one and no offset."""
 
-    xyz: FloatArray  # (N, 3), float64 or float32
+    xyz: NDArray[Any]  # (N, 3): int32 with step and ref, or float
     classification: NDArray[np.uint8] | None = None  # ASPRS classes, when the file has them
     colors: NDArray[np.uint8] | None = None  # (N, 3)
     crs_scale: float | None = None  # m per horizontal unit, from the file's CRS
     crs_vertical: float | None = None  # m per vertical unit, when the CRS says
     crs_note: str = ""  # where the units came from, for the world file
     crs_wkt: str | None = None  # the file's coordinate system (WKT), when it has one
-    ref: FloatArray = field(default_factory=lambda: np.zeros(3))  # file units
+    step: FloatArray = field(default_factory=lambda: np.ones(3))
+    ref: FloatArray = field(default_factory=lambda: np.zeros(3))
     resolution: float | None = None  # the file's coordinate step (a LAS scale factor)
-    held: int | None = None  # points the file holds, when more than were kept
+    held: int | None = None  # points the file holds, when not all were kept
     notes: list[str] = field(default_factory=list)  # what the reader did about the file
+
+    def __len__(self) -> int:
+        return len(self.xyz)
+
+    def coordinates(self, lo: int, hi: int) -> FloatArray:
+        """Rows ``lo:hi`` in the file's units, as float64 (as laspy scales them)."""
+        block = self.xyz[lo:hi]
+        if block.dtype.kind == "f" and not self.ref.any() and (self.step == 1).all():
+            return np.asarray(block, dtype=np.float64)
+        return np.asarray(block * self.step + self.ref, dtype=np.float64)
 
 
 @dataclass
@@ -59,6 +73,17 @@ class ReadRequest:
 
 
 Reader = Callable[[Path, ReadRequest], Cloud | Mesh]
+KEPT_POINT_BYTES = 64  # memory an imported point costs at the import's peak
+DEFAULT_MAX_POINTS = 50_000_000  # beyond this a cloud is thinned unless --max-points says
+
+
+def max_points(request: ReadRequest) -> int:
+    """The most points to keep: as asked, else what half the available memory holds (at most
+    ``DEFAULT_MAX_POINTS``)."""
+    if request.max_points is not None:
+        return max(request.max_points, 1)
+    room = available_memory() / 2 / KEPT_POINT_BYTES
+    return int(max(min(room, DEFAULT_MAX_POINTS), 1_000))
 READERS: Registry[str, Reader] = Registry("file format")
 # Bytes of memory a file needs per byte on disk (or per point, for LAS/LAZ) while imported.
 MEMORY_PER_BYTE: dict[str, float] = {}
@@ -79,25 +104,41 @@ def extension(path: Path) -> str:
     return path.suffix.lower().lstrip(".")
 
 
-def lookup(path: Path) -> Reader:
+def lookup(path: Path, fmt: str) -> Reader:
+    """The reader of format ``fmt`` (a file's extension, or ``--format``)."""
     try:
-        return READERS.get(extension(path))
+        return READERS.get(fmt.lower().lstrip("."))
     except UnknownEntry:
         known = ", ".join(f".{e}" for e in READERS)
-        raise InputError(f"unknown format '{path.suffix or '(no extension)'}'; "
-                         f"known: {known}", file=path) from None
+        if fmt == extension(path):
+            raise InputError(f"unknown format '{path.suffix or '(no extension)'}'; "
+                             f"known: {known}; --format reads it as one of them",
+                             file=path) from None
+        raise InputError(f"unknown format '{fmt}'; known: {known}", key="--format") from None
 
 
-def check_file(path: Path) -> None:
-    """A file that exists, is not empty and fits in memory, or an :class:`InputError`."""
-    if not path.exists():
-        raise InputError("no such file", file=path)
-    if not path.is_file():
-        raise InputError("not a file", file=path)
-    size = path.stat().st_size
+def check_file(path: Path, fmt: str) -> None:
+    """A regular file that is not empty and fits in memory, or an :class:`InputError`: a
+    folder, a FIFO or a device (``/dev/zero``) is refused before anything reads it."""
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        raise InputError("no such file", file=path) from None
+    except OSError as exc:
+        raise InputError(f"cannot be read ({exc.strerror})", file=path) from None
+    if stat.S_ISDIR(info.st_mode):
+        raise InputError("a folder, not a file", file=path)
+    if not stat.S_ISREG(info.st_mode):
+        kind = "a FIFO" if stat.S_ISFIFO(info.st_mode) else "a device" if (
+            stat.S_ISCHR(info.st_mode) or stat.S_ISBLK(info.st_mode)) else "a special file"
+        raise InputError(f"{kind}, not a regular file: import reads files it can measure",
+                         file=path)
+    if not os.access(path, os.R_OK):
+        raise InputError("cannot be read (permission denied)", file=path)
+    size = info.st_size
     if size == 0:
         raise InputError("the file is empty", file=path)
-    need = size * MEMORY_PER_BYTE.get(extension(path), 10.0)
+    need = size * MEMORY_PER_BYTE.get(fmt.lower().lstrip("."), 10.0)
     check_memory(path, need, f"a {size / 1e6:,.0f} MB file")
 
 

@@ -13,7 +13,6 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import ndimage
 
 from astralis_des.errors import InputError
 from astralis_des.world.geometry import FloatArray
@@ -55,31 +54,12 @@ def unique_rows(index: IntArray) -> IntArray:
     return np.column_stack(np.unravel_index(flat, dims)).astype(np.int64) + low
 
 
-def column_tops(xy_index: IntArray, heights: FloatArray, shape: tuple[int, int], voxel: float,
-                close: int) -> NDArray[np.int32]:
-    """``(nx, ny)`` top of each occupied column, in voxels above the ground (0: none).
-
-    An aerial scan sees roofs and canopies, not what is below them: each column is solid from
-    the ground up to its highest point. A grey closing of ``close`` cells fills the holes that
-    the scan's point spacing leaves between the columns of one roof.
-    """
-    top = np.zeros(shape, dtype=np.float64)
-    np.maximum.at(top, (xy_index[:, 0], xy_index[:, 1]), heights)
-    if close > 1:
-        top = ndimage.grey_closing(top, size=(close, close))
-    return np.ceil(top / voxel - 1e-6).astype(np.int32)
-
-
-def boxes_from_columns(tops: NDArray[np.int32]) -> IntArray:
-    """Merged boxes of columns standing on ``k = 0`` up to ``tops``."""
-    i, j = np.nonzero(tops > 0)
-    runs = np.column_stack([i, j, j + 1, np.zeros_like(i), tops[i, j]]).astype(np.int64)
+def boxes_from_columns(i: IntArray, j: IntArray, tops: NDArray[np.int32]) -> IntArray:
+    """Merged boxes of columns ``(i, j)`` standing on ``k = 0`` up to ``tops`` voxels."""
+    stand = tops > 0
+    i, j, tops = i[stand], j[stand], tops[stand]
+    runs = np.column_stack([i, j, j + 1, np.zeros_like(i), tops]).astype(np.int64)
     return _merge_x(_merge_y(runs))
-
-
-def boxes_from_voxels(occupied: BoolArray) -> IntArray:
-    """Merged boxes of a dense ``(nx, ny, nz)`` occupancy."""
-    return boxes_from_indices(np.argwhere(occupied))
 
 
 def boxes_from_indices(cells: IntArray) -> IntArray:
@@ -98,6 +78,8 @@ def boxes_from_indices(cells: IntArray) -> IntArray:
 
 def _merge_y(runs: IntArray) -> IntArray:
     """z-runs ``(i, j, j + 1, k0, k1)`` side by side along y become ``(i, j0, j1, k0, k1)``."""
+    if len(runs) == 0:
+        return np.zeros((0, 5), dtype=np.int64)
     order = np.lexsort((runs[:, 1], runs[:, 4], runs[:, 3], runs[:, 0]))
     r = runs[order]
     same = np.zeros(len(r), dtype=bool)
@@ -127,11 +109,3 @@ def box_corners(boxes: IntArray, voxel: float) -> FloatArray:
     """``(K, 2, 3)`` corners in metres of index boxes."""
     b = np.asarray(boxes, dtype=float).reshape(-1, 6) * voxel
     return np.stack([b[:, :3], b[:, 3:]], axis=1)
-
-
-def occupancy_of_boxes(boxes: IntArray, shape: tuple[int, int, int]) -> BoolArray:
-    """The dense occupancy that ``boxes`` cover (what merging started from)."""
-    grid = np.zeros(shape, dtype=bool)
-    for i0, j0, k0, i1, j1, k1 in np.asarray(boxes, dtype=np.int64):
-        grid[i0:i1, j0:j1, k0:k1] = True
-    return grid

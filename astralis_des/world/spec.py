@@ -129,6 +129,10 @@ class SourceSpec(Strict):
     faces: NonNegativeInt | None = Field(None, description="triangles read (a mesh)")
     dropped: NonNegativeInt = Field(0, description="points or vertices with NaN or infinite "
                                     "coordinates, left out")
+    strays: NonNegativeInt = Field(0, description="points left out for lying far from the "
+                                   "rest of the cloud")
+    kept: NonNegativeInt | None = Field(None, description="points kept, when the cloud was "
+                                        "thinned evenly to fit (--max-points)")
     units: str = Field(description="the file's unit and where it was found")
     scale: PositiveFloat = Field(description="metres per unit of the file")
     up: Literal["y", "z"] = "z"
