@@ -66,8 +66,9 @@ def build(cloud: Cloud, found: Survey, ground: Ground, origin: FloatArray,
         m = m[keep]
         classes = cloud.classification[lo:hi][keep] if cloud.classification is not None \
             else None
-        height = m[:, 2] - ground.height(m)
-        on_ground = ground.is_ground(m, classes)
+        surface = ground.height(m)
+        height = m[:, 2] - surface
+        on_ground = ground.is_ground(m, classes, surface)
         standing = ~on_ground & (height > MIN_HEIGHT)
         canopy = np.zeros(len(m), dtype=bool)
         if classes is not None:

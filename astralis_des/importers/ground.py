@@ -56,10 +56,11 @@ class Ground:
         return np.asarray(ndimage.map_coordinates(self.heights, [u[:, 0], u[:, 1]], order=1,
                                                   mode="nearest"))
 
-    def is_ground(self, xyz: FloatArray, classification: NDArray[np.uint8] | None
-                  ) -> NDArray[np.bool_]:
+    def is_ground(self, xyz: FloatArray, classification: NDArray[np.uint8] | None,
+                  surface: FloatArray | None = None) -> NDArray[np.bool_]:
         """``(N,)``: the points of class 2 (``classification``), within ``RANSAC_TOLERANCE``
-        of the plane (``ransac``), or on the surface's lower envelope (``grid``)."""
+        of the plane (``ransac``), or on the surface's lower envelope (``grid``);
+        ``surface`` is :meth:`height` at ``xyz``, when the caller has it."""
         if self.method == "classification":
             assert classification is not None
             return np.asarray(classification == GROUND_CLASS)
@@ -67,7 +68,8 @@ class Ground:
             a, b, c = self.plane
             return np.asarray(np.abs(xyz[:, 2] - (a * xyz[:, 0] + b * xyz[:, 1] + c))
                               <= RANSAC_TOLERANCE)
-        return np.asarray(xyz[:, 2] <= self.height(xyz) + TOLERANCE)
+        below = self.height(xyz) if surface is None else surface
+        return np.asarray(xyz[:, 2] <= below + TOLERANCE)
 
     @property
     def relief(self) -> float:

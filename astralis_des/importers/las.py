@@ -1,13 +1,13 @@
 """LAS, LAZ and COPC: every version (1.0 to 1.4) and point format (0 to 10), streamed.
 
 The header is checked against the file first (:mod:`.lasfile`): a truncated file, a broken VLR
-count or a point count the file cannot hold is found before laspy reads a point. Points are
-streamed in chunks (laspy's ``chunk_iterator``) into float32 offsets from the first point, so a
-cloud costs 12 bytes a point, plus its classes and colours; beyond ``max_points`` every k-th
-point is kept. A LAZ is read with lazrs, and, where lazrs cannot (LASzip's point-wise
-compressor of version 1.x, or an error), with laspy's other backend, laszip. A COPC whose
-points are more than needed is read level by level (laspy's ``CopcReader``) down to the
-deepest level that fits.
+or EVLR count, a point count the file cannot hold or a chunk table that is lost or unsound is
+found before laspy reads a point. Points are streamed in chunks (laspy's ``chunk_iterator``)
+and kept as the file stores them, so a cloud costs 12 bytes a point, plus its classes and
+colours; beyond ``max_points`` every k-th point is kept. A LAZ is read with lazrs, and, where
+lazrs cannot (LASzip's point-wise compressor of version 1.x, or an error), with laspy's other
+backend, laszip; a LAZ cut short reads its whole chunks. A COPC whose points are more than
+needed is read level by level down to the deepest level that fits, its octree checked first.
 """
 
 from __future__ import annotations
@@ -24,16 +24,18 @@ import numpy as np
 
 from astralis_des.errors import InputError
 from astralis_des.importers.lasfile import (
-    LASZIP,
     POINTWISE,
+    VARIABLE,
     Layout,
     Mended,
+    Node,
+    copc_nodes,
     counting,
-    laszip_compressor,
     layout,
+    laz_tail,
     problems,
 )
-from astralis_des.importers.pointcloud import library_error
+from astralis_des.importers.pointcloud import library_error, partial_hint
 from astralis_des.importers.source import (
     FOOT,
     US_SURVEY_FOOT,
@@ -46,6 +48,7 @@ from astralis_des.importers.source import (
 log = logging.getLogger(__name__)
 
 CHUNK = 1_000_000  # points decompressed at a time
+PARALLEL_BYTES = 1 << 28  # the biggest decompressed chunk lazrs's parallel reader may hold
 # EPSG codes of linear units in a GeoTIFF key directory (ProjLinearUnitsGeoKey, 3076).
 LINEAR_UNITS = {9001: ("m", 1.0), 9002: ("ft", FOOT), 9003: ("US survey ft", US_SURVEY_FOOT)}
 PROJ_LINEAR_UNITS, VERTICAL_UNITS = 3076, 4099
@@ -58,66 +61,99 @@ _PASSING = (KeyboardInterrupt, SystemExit, GeneratorExit)
 def read_las(path: Path, request: ReadRequest) -> Cloud:
     """The points of a LAS/LAZ/COPC file, with their classes and colours; units from the
     header's coordinate system."""
-    import laspy
-
+    keep = max_points(request)
     with path.open("rb") as raw:
         found = layout(path, raw)
-        backends = _backends(path, raw, found)
+        copc = found.is_copc and found.laz is not None and found.count > keep
+        octree = copc_nodes(path, raw, found) if copc else None
+    backends = _backends(path, found)
     notes = problems(found)
     count = found.count
     if not found.compressed and count > found.whole_points:
         _short(path, found.whole_points, count, request, "")
         found = counting(found, found.whole_points)  # --partial: what the file holds
-    keep = max_points(request)
-    if found.is_copc and count > keep:
-        cloud = _read_copc(path, found, keep, request)
+    if octree is not None:
+        cloud, header = _read_copc(path, found, octree, keep, request)
     else:
-        cloud = _read_stream(path, found, backends, keep, request)
+        found = _chunks_checked(path, found, request)
+        cloud, header = _read_stream(path, found, backends, keep, request)
     if found.count < count:
         notes.append(f"--partial: read the {found.count:,} whole points the file holds, of "
                      f"the {count:,} its header announces")
     cloud.notes[:0] = notes
-    with laspy.open(Mended(path.open("rb"), found.patches), laz_backend=()) as opened:
-        cloud.crs_scale, cloud.crs_vertical, cloud.crs_note = _las_units(opened.header)
-        cloud.crs_wkt = _las_crs(opened.header)
-        cloud.resolution = float(min(opened.header.scales[:2]))
+    with _laspy_quiet():
+        cloud.crs_scale, cloud.crs_vertical, cloud.crs_note = _las_units(header)
+        cloud.crs_wkt = _las_crs(header)
+    cloud.resolution = float(min(header.scales[:2]))
     return cloud
 
 
-def _backends(path: Path, raw: Any, found: Layout) -> tuple[Any, ...]:
+def _backends(path: Path, found: Layout) -> tuple[Any, ...]:
     """The LAZ backends to try, in order: lazrs, then laszip; laszip alone for LASzip's
-    point-wise compressor, which lazrs cannot read."""
+    point-wise compressor, which lazrs cannot read; lazrs's sequential reader alone for a
+    LAZ whose chunk table is lost, and before laszip for chunks too big for the parallel
+    reader, which holds a whole chunk decompressed."""
     import laspy
 
-    if not found.compressed:
+    if found.laz is None:
         return ()
-    where = found.vlr(*LASZIP)
-    if where is None:
-        raise InputError("not a readable LAZ file (its points are compressed, but it has no "
-                         "LASzip VLR to say how)", file=path)
-    compressor, major = laszip_compressor(raw, where)
     available = laspy.LazBackend.detect_available()
     lazrs = [b for b in available if b in (laspy.LazBackend.LazrsParallel,
                                           laspy.LazBackend.Lazrs)][:1]
     laszip = [b for b in available if b == laspy.LazBackend.Laszip]
-    if compressor == POINTWISE:
+    if found.laz.compressor == POINTWISE:
         if not laszip:
-            raise InputError(f"compressed by LASzip {major}'s point-wise compressor, which "
-                             "only laspy's laszip backend reads: pip install laszip", file=path)
+            raise InputError(f"compressed by LASzip {found.laz.major}'s point-wise compressor, "
+                             "which only laspy's laszip backend reads: pip install laszip",
+                             file=path)
         return tuple(laszip)
     if not lazrs + laszip:
         raise InputError("a LAZ file needs one of laspy's LAZ backends: pip install lazrs",
                          file=path)
+    sequential = [b for b in available if b == laspy.LazBackend.Lazrs]
+    if found.laz.chunks is None and sequential:
+        return tuple(sequential)
+    if found.laz.biggest * found.record_length > PARALLEL_BYTES:
+        return tuple(sequential + laszip)
     return tuple(lazrs + laszip)
+
+
+def _chunks_checked(path: Path, found: Layout, request: ReadRequest) -> Layout:
+    """A LAZ's header count against its chunk table: more points than its chunks hold is a
+    truncated file (refused, or read as far as its chunks go with --partial); a lost table
+    is replaced by an empty one, so that the chunks are read one after another."""
+    laz = found.laz
+    if laz is None or laz.compressor == POINTWISE or not found.count:
+        return found
+    capacity = laz.capacity
+    if capacity is None:
+        if laz.chunk_size == VARIABLE:
+            raise InputError("truncated or damaged: its chunk table cannot be read, and its "
+                             "chunks vary in size, so none can be told apart", file=path)
+        return laz_tail(found)
+    if found.count <= capacity:
+        return found
+    if laz.chunk_size == VARIABLE:
+        _short(path, capacity, found.count, request, "")
+        return counting(found, capacity)
+    whole = capacity - laz.chunk_size  # the last chunk may hold fewer: no count says
+    if not (request.partial and whole):
+        chunks = len(laz.chunks or ())
+        raise InputError(f"truncated: the header announces {found.count:,} points, more than "
+                         f"the {chunks:,} chunk{'s' if chunks > 1 else ''} of "
+                         f"{laz.chunk_size:,} its chunk table lists can hold"
+                         + (f"; pass --partial to import the {whole:,} of its chunks before "
+                            "the last" if whole else ""), file=path)
+    return counting(found, whole)
 
 
 class _Points:
     """Chunks of points kept as the file stores them (int32 with the header's scale and
     offset): every ``stride``-th point when there are more than memory allows."""
 
-    def __init__(self, count: int, stride: int, colors: bool, classes: bool) -> None:
+    def __init__(self, room: int, stride: int, colors: bool, classes: bool) -> None:
         self.stride = stride
-        room = max(min(count, math.ceil(count / stride)), 0)
+        room = max(room, 0)
         self.xyz = np.empty((room, 3), dtype=np.int32)
         self.classes = np.empty(room, dtype=np.uint8) if classes else None
         self.rgb = np.empty((room, 3), dtype=np.uint16) if colors else None
@@ -144,6 +180,11 @@ class _Points:
                 self.rgb[at, axis] = np.asarray(chunk[name])[pick]
         self.kept += n
 
+    def cut(self, read: int) -> None:
+        """Keep the points of the first ``read`` only."""
+        self.read = min(self.read, read)
+        self.kept = min(self.kept, -(-self.read // self.stride))
+
     def _grow(self, need: int) -> None:
         size = max(need, 2 * len(self.xyz))
         self.xyz = np.resize(self.xyz, (size, 3))
@@ -164,21 +205,26 @@ class _Points:
 
 
 def _read_stream(path: Path, found: Layout, backends: tuple[Any, ...], keep: int,
-                 request: ReadRequest) -> Cloud:
+                 request: ReadRequest) -> tuple[Cloud, Any]:
     """Every point in file order (every k-th beyond ``keep``), with the first backend that
     reads the file; a failure after points were read is the file's, not the backend's."""
     stride = max(math.ceil(found.count / keep), 1) if found.count else 1
     names = _dimensions(found)
+    batch, whole = _batches(found)
+    trusted = found.laz is None or found.laz.chunks is not None
+    room = math.ceil(found.count / stride) if trusted else math.ceil(min(found.count, CHUNK)
+                                                                     / stride)
     failure: BaseException | None = None
     for backend in backends or (None,):
-        points = _Points(found.count, stride, {"red", "green", "blue"} <= names,
+        points = _Points(room, stride, {"red", "green", "blue"} <= names,
                          "classification" in names)
         try:
-            _stream(path, found, backend, points, request)
+            _stream(path, found, backend, points, batch, request)
         except _PASSING:
             raise
         except BaseException as exc:  # lazrs raises a PanicException (a BaseException)
             failure = exc
+            points.cut(points.read - points.read % whole)
             if points.read:  # the file's data, not the backend: another would fail too
                 break
             log.info("%s: the LAZ backend %s failed (%s)", path, backend, exc)
@@ -188,7 +234,7 @@ def _read_stream(path: Path, found: Layout, backends: tuple[Any, ...], keep: int
     if failure is not None and not (request.partial and points.kept):
         if points.read:
             _short(path, points.read, found.count, request, _reason(path, failure))
-        raise library_error(path, path.suffix.lstrip(".").upper() or "LAS",
+        raise library_error(path, "LAZ" if found.compressed else "LAS",
                             _exception(failure)) from None
     if points.read < found.count:
         _short(path, points.read, found.count, request, "")
@@ -201,17 +247,29 @@ def _read_stream(path: Path, found: Layout, backends: tuple[Any, ...], keep: int
     if stride > 1:
         cloud.notes.append(f"kept every {_nth(stride)} point ({points.kept:,} of "
                            f"{points.read:,}) to stay within --max-points {keep:,}")
-    return cloud
+    return cloud, points.header
 
 
-def _stream(path: Path, found: Layout, backend: Any, points: _Points,
+def _batches(found: Layout) -> tuple[int, int]:
+    """Points to read at a time, and the run of points a failure loses: whole chunks of a
+    chunked LAZ (one at a time when its table is lost, to keep every whole one)."""
+    laz = found.laz
+    if laz is None or laz.compressor == POINTWISE or laz.chunk_size == VARIABLE:
+        return CHUNK, 1
+    size = laz.chunk_size
+    if laz.chunks is None or size > CHUNK:
+        return min(size, CHUNK), size
+    return size * (CHUNK // size), size
+
+
+def _stream(path: Path, found: Layout, backend: Any, points: _Points, batch: int,
             request: ReadRequest) -> None:
     import laspy
 
-    with _laspy_quiet(), laspy.open(Mended(path.open("rb"), found.patches),
-                                    laz_backend=backend or ()) as opened:
+    with _laspy_quiet(), path.open("rb") as raw, laspy.open(
+            Mended(raw, found.patches), laz_backend=backend or ()) as opened:
         points.header = opened.header
-        for chunk in opened.chunk_iterator(CHUNK):
+        for chunk in opened.chunk_iterator(batch):
             points.add(chunk)
             if request.progress is not None:
                 request.progress(points.read, found.count)
@@ -243,18 +301,18 @@ def _short(path: Path, held: int, count: int, request: ReadRequest, why: str) ->
     ``partial`` (then read as far as it goes)."""
     if request.partial and held:
         return
-    hint = f"; pass --partial to import the {held:,} it holds" if held else ""
     if not why or why.startswith("truncated"):
         raise InputError(f"truncated: the header announces {count:,} points, the file holds "
-                         f"{held:,}{hint}", file=path)
-    raise InputError(f"damaged after {held:,} of its {count:,} points ({why}){hint}",
-                     file=path)
+                         f"{held:,}{partial_hint(held)}", file=path)
+    raise InputError(f"damaged after {held:,} of its {count:,} points ({why})"
+                     f"{partial_hint(held)}", file=path)
 
 
 @contextmanager
 def _laspy_quiet() -> Iterator[None]:
-    """laspy logs a backend that fails and a short read as errors; both are said here in one
-    line of our own, so its records are kept from the console."""
+    """laspy logs a backend that fails, a short read and a VLR it cannot parse as errors and
+    warnings; what matters is said here in one line of our own, so its records are kept from
+    the console."""
     logger = logging.getLogger("laspy")
     before = logger.propagate, logger.level
     logger.propagate, logger.level = False, logging.CRITICAL + 1
@@ -264,37 +322,65 @@ def _laspy_quiet() -> Iterator[None]:
         logger.propagate, logger.level = before
 
 
-def _read_copc(path: Path, found: Layout, keep: int, request: ReadRequest) -> Cloud:
+def _read_copc(path: Path, found: Layout, octree: tuple[float, list[Node]], keep: int,
+               request: ReadRequest) -> tuple[Cloud, Any]:
     """The coarse levels of a COPC octree, down to the deepest whose points (with all above
-    it) number at most ``keep``: the cloud thinned evenly in space, the rest never read."""
-    import laspy
-    from laspy.copc import load_octree_for_query
+    it) number at most ``keep`` (the root level thinned when even it is more): the cloud
+    thinned evenly in space, the rest never read."""
+    spacing, nodes = octree
+    per_level: dict[int, int] = {}
+    for node in nodes:
+        per_level[node.level] = per_level.get(node.level, 0) + node.points
+    levels, total = 0, 0
+    for level in sorted(per_level):
+        if total + per_level[level] > keep and levels:
+            break
+        total += per_level[level]
+        levels = level + 1
+    stride = max(math.ceil(total / keep), 1)
+    try:
+        cloud, header = _copc_levels(path, found, [n for n in nodes if n.level < levels],
+                                     total, stride, request)
+    except (InputError, *_PASSING):
+        raise
+    except BaseException as exc:  # lazrs's panics are BaseExceptions
+        raise library_error(path, "COPC", _exception(exc)) from None
+    cloud.held = found.count
+    thinned = f", every {_nth(stride)} point of them" if stride > 1 else ""
+    cloud.notes.append(f"COPC: read octree levels 0 to {levels - 1} of {max(per_level) + 1} "
+                       f"({len(cloud):,} of {found.count:,} points{thinned}, spaced about "
+                       f"{spacing / 2 ** (levels - 1):.3g} file units): within --max-points "
+                       f"{keep:,}")
+    return cloud, header
 
-    with _laspy_quiet(), laspy.CopcReader.open(str(path)) as copc:
-        nodes = load_octree_for_query(copc.source, copc.copc_info, copc.root_page)
-        per_level: dict[int, int] = {}
-        for node in nodes:
-            per_level[node.key.level] = per_level.get(node.key.level, 0) + node.point_count
-        levels, total = 0, 0
-        for level in sorted(per_level):
-            if total + per_level[level] > keep and levels:
-                break
-            total += per_level[level]
-            levels = level + 1
-        names = set(copc.header.point_format.dimension_names)
-        points = _Points(total, 1, {"red", "green", "blue"} <= names, "classification" in names)
-        points.header = copc.header
-        for level in range(levels):
-            points.add(copc.query(level=level))
+
+def _copc_levels(path: Path, found: Layout, nodes: list[Node], total: int, stride: int,
+                 request: ReadRequest) -> tuple[Cloud, Any]:
+    """The points of ``nodes``, level by level, each level's chunks decompressed together."""
+    import laspy
+    import lazrs
+
+    assert found.laz is not None
+    with _laspy_quiet(), path.open("rb") as raw, path.open("rb") as head, laspy.open(
+            Mended(head, found.patches), laz_backend=()) as opened:
+        header = opened.header
+        names = set(header.point_format.dimension_names)
+        points = _Points(math.ceil(total / stride), stride, {"red", "green", "blue"} <= names,
+                         "classification" in names)
+        points.header = header
+        for level in sorted({n.level for n in nodes}):
+            chosen = sorted((n for n in nodes if n.level == level), key=lambda n: n.offset)
+            data = bytearray()
+            for node in chosen:
+                raw.seek(node.offset)
+                data += raw.read(node.size)
+            out = np.zeros(sum(n.points for n in chosen) * header.point_format.size, np.uint8)
+            lazrs.decompress_points_with_chunk_table(
+                bytes(data), found.laz.record, out, [(n.points, n.size) for n in chosen])
+            points.add(laspy.PackedPointRecord.from_buffer(out, header.point_format))
             if request.progress is not None:
                 request.progress(points.read, total)
-        spacing = float(copc.copc_info.spacing) / 2 ** (levels - 1)
-    cloud = points.cloud()
-    cloud.held = found.count
-    cloud.notes.append(f"COPC: read octree levels 0 to {levels - 1} of {max(per_level) + 1} "
-                       f"({points.kept:,} of {found.count:,} points, spaced about "
-                       f"{spacing:.3g} file units): within --max-points {keep:,}")
-    return cloud
+    return points.cloud(), header
 
 
 def _las_crs(header: Any) -> str | None:
@@ -308,24 +394,52 @@ def _las_crs(header: Any) -> str | None:
 
 
 def _las_units(header: Any) -> tuple[float | None, float | None, str]:
-    """Metres per horizontal and vertical unit from the GeoTIFF keys, else the WKT."""
-    for vlr in header.vlrs:
+    """Metres per horizontal and vertical unit from the GeoTIFF keys, else the WKT (in a VLR
+    or, in LAS 1.4, an EVLR)."""
+    records = [*header.vlrs, *(header.evlrs or ())]
+    for vlr in records:
         keys = {k.id: k.value_offset for k in getattr(vlr, "geo_keys", [])}
         if PROJ_LINEAR_UNITS in keys and keys[PROJ_LINEAR_UNITS] in LINEAR_UNITS:
             name, scale = LINEAR_UNITS[keys[PROJ_LINEAR_UNITS]]
             vertical = LINEAR_UNITS.get(keys.get(VERTICAL_UNITS, -1), (None, None))[1]
             return (scale, vertical, f"{name} (EPSG {keys[PROJ_LINEAR_UNITS]}, "
                     "from the header's GeoTIFF keys)")
-    for vlr in header.vlrs:
+    for vlr in records:
         text = getattr(vlr, "string", None)
         if isinstance(text, bytes):
             text = text.decode("ascii", "replace")
-        if not isinstance(text, str):
-            continue
-        linear = [(n, float(f)) for n, f in _WKT_UNIT.findall(text)
-                  if not any(a in n.lower() for a in _ANGULAR)]
-        if linear:
-            name, scale = linear[0]
-            vertical = linear[1][1] if len(linear) > 1 else None
-            return scale, vertical, f"{name} ({scale:g} m, from the header's WKT)"
+        units = _wkt_units(text) if isinstance(text, str) else None
+        if units is not None:
+            return units
     return None, None, ""
+
+
+def _wkt_units(text: str) -> tuple[float, float | None, str] | None:
+    """Metres per unit of a WKT's projected system (and of its vertical one) as pyproj reads
+    them; from its UNIT keywords when pyproj cannot read it (the first one not of angles)."""
+    from pyproj import CRS
+
+    try:
+        crs = CRS.from_wkt(text)
+    except Exception:  # pyproj's CRSError, or worse for a damaged WKT
+        linear = [(n, float(f)) for n, f in _WKT_UNIT.findall(text)
+                  if not any(a in n.lower() for a in _ANGULAR) and _is_number(f)]
+        if not linear:
+            return None
+        (name, scale), vertical = linear[0], linear[1][1] if len(linear) > 1 else None
+        return scale, vertical, f"{name} ({scale:g} m, from the header's WKT)"
+    parts = crs.sub_crs_list if crs.is_compound else [crs]
+    if not parts or not parts[0].is_projected or not parts[0].axis_info:
+        return None  # degrees: projected where the frame is made
+    axis = parts[0].axis_info[0]
+    scale = float(axis.unit_conversion_factor)
+    heights = parts[1].axis_info if len(parts) > 1 else []
+    vertical = float(heights[0].unit_conversion_factor) if heights else None
+    return scale, vertical, f"{axis.unit_name} ({scale:g} m, from the header's WKT)"
+
+
+def _is_number(text: str) -> bool:
+    try:
+        return math.isfinite(float(text))
+    except ValueError:
+        return False
