@@ -252,3 +252,20 @@ def test_the_same_points_in_every_format_and_compressor_make_the_same_world(
     simple = blocks("las/simple.las")
     assert np.array_equal(blocks("laz/simple.laz"), simple)
     assert np.array_equal(blocks("laz/simple-laszip-compressor-version-1.2r0.laz"), simple)
+
+
+def test_the_command_says_what_it_guessed_chose_and_warns_of(
+        capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    """`astralis world import simple.las`: the units it guessed and how to override them, the
+    voxel it chose and why, and that the world is coarse; exit 0."""
+    from astralis_des.cli import main
+
+    assert main(["world", "import", str(SCANS / "las" / "simple.las"), "-o",
+                 str(tmp_path / "simple.yaml")]) == 0
+    said = " ".join(capsys.readouterr().out.split())
+    assert "1,065 points, site 3370 x 4640 m, voxel 10 m, 497 blocks" in said
+    assert "units: m (guessed: no coordinate system in the file; pass --units m, ft or us-ft, " \
+        "or --crs (e.g. EPSG:32617) if it is not in metres)" in said
+    assert "voxel 10 m, the coarsest, though the points lie further apart (one point per " \
+        "119 m: 1,065 points over the 15,204,352 m^2 they cover); --voxel to choose" in said
+    assert "warning: a sparse cloud, so a coarse world" in said

@@ -1,13 +1,15 @@
 """Search areas on a scanned site's open ground: ground the scan saw (cells holding points,
 small gaps closed), clear of blocks by ``CLEARANCE``; or one line saying why there is none.
 
-The areas' grid is the voxel's, coarsened to a multiple of it where the site would need more
-than ``MAX_RASTER`` cells.
+The areas' grid is the voxel's. On a site of more than ``MAX_RASTER`` voxel columns it covers
+a window of that many around the middle of the ground the scan saw, where the areas go (each
+next one is placed nearest the last), so that its memory does not grow with the site.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +18,7 @@ from scipy import ndimage
 from astralis_des.errors import InputError
 from astralis_des.importers.areas import MIN_SIZE, Area, Level, place_areas
 from astralis_des.importers.cloudbuild import AREA_HEIGHT, Blocks
-from astralis_des.importers.density import raster_cell
+from astralis_des.importers.density import MAX_RASTER
 from astralis_des.importers.options import ImportOptions
 from astralis_des.importers.survey import Survey
 
@@ -29,19 +31,18 @@ def cloud_areas(blocks: Blocks, shape: tuple[int, int], voxel: float, found: Sur
     gives what the scan covers and what would work."""
     if opts.areas == 0:
         return []
-    cell = raster_cell(voxel, np.array(shape) * voxel)
-    every = round(cell / voxel)
-    plan = (math.ceil(shape[0] / every), math.ceil(shape[1] / every))
-    seen = _seen(blocks, plan, cell)
-    blocked = np.zeros(plan, dtype=bool)
-    blocked[blocks.blocked[:, 0] // every, blocks.blocked[:, 1] // every] = True
-    clear = max(math.ceil(CLEARANCE / cell), 1)
+    lo, plan = _window(blocks, shape, voxel)
+    seen = _seen(blocks, lo, plan, voxel)
+    blocked = np.zeros((int(plan[0]), int(plan[1])), dtype=bool)
+    inside = np.all((blocks.blocked >= lo) & (blocks.blocked < lo + plan), axis=1)
+    blocked[blocks.blocked[inside, 0] - lo[0], blocks.blocked[inside, 1] - lo[1]] = True
+    clear = max(math.ceil(CLEARANCE / voxel), 1)
     near = ndimage.maximum_filter(blocked, size=2 * clear + 1)  # a square dilation, separable
     free = seen & ~near
-    areas = place_areas([Level(0.0, free)], cell, opts.areas, opts.area_size,
-                        lambda z, si, sj: AREA_HEIGHT)
+    areas = [_shifted(a, lo * voxel) for a in place_areas(
+        [Level(0.0, free)], voxel, opts.areas, opts.area_size, lambda z, si, sj: AREA_HEIGHT)]
     if not areas:
-        raise InputError(_none(found, seen, free, cell, opts), file=path)
+        raise InputError(_none(found, seen, free, voxel, opts), file=path)
     small = [a for a in areas if a.hi[0] - a.lo[0] < opts.area_size - 1e-6]
     if small:
         side = small[0].hi[0] - small[0].lo[0]
@@ -50,15 +51,37 @@ def cloud_areas(blocks: Blocks, shape: tuple[int, int], voxel: float, found: Sur
     return areas
 
 
-def _seen(blocks: Blocks, plan: tuple[int, int], cell: float) -> np.ndarray:
-    """``plan``-shaped: is the ground under each cell's middle in a cell the scan saw?"""
+def _window(blocks: Blocks, shape: tuple[int, int], voxel: float
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """The corner and shape (voxel columns) of the areas' grid: the whole site, or a window of
+    ``MAX_RASTER`` columns round the middle of what the scan saw."""
+    site = np.array(shape, dtype=np.int64)
+    side = math.isqrt(MAX_RASTER)
+    if int(site.prod()) <= MAX_RASTER or not len(blocks.seen):
+        return np.zeros(2, dtype=np.int64), site
+    middle = ((blocks.seen.mean(axis=0) + 0.5) * blocks.seen_cell / voxel).astype(np.int64)
+    plan = np.minimum(site, side)
+    lo = np.clip(middle - plan // 2, 0, site - plan)
+    return lo, plan
+
+
+def _shifted(area: Area, by: np.ndarray) -> Area:
+    dx, dy = (float(v) for v in by)
+    return replace(area, lo=(round(area.lo[0] + dx, 3), round(area.lo[1] + dy, 3), area.lo[2]),
+                   hi=(round(area.hi[0] + dx, 3), round(area.hi[1] + dy, 3), area.hi[2]))
+
+
+def _seen(blocks: Blocks, lo: np.ndarray, size: np.ndarray, cell: float) -> np.ndarray:
+    """``size``-shaped, from voxel column ``lo``: is the ground under each cell's middle in a
+    cell the scan saw?"""
     coarse = blocks.seen_cell
+    plan = (int(size[0]), int(size[1]))
     if not len(blocks.seen):
         return np.zeros(plan, dtype=bool)
     seen = np.zeros(tuple(int(n) for n in blocks.seen.max(axis=0) + 1), dtype=bool)
     seen[blocks.seen[:, 0], blocks.seen[:, 1]] = True
     seen = ndimage.binary_closing(seen, np.ones((3, 3), dtype=bool))
-    centre = ((np.indices(plan) + 0.5) * cell / coarse).astype(np.int64)
+    centre = ((np.indices(plan) + lo[:, None, None] + 0.5) * cell / coarse).astype(np.int64)
     inside = (centre[0] < seen.shape[0]) & (centre[1] < seen.shape[1])
     fine = np.zeros(plan, dtype=bool)
     fine[inside] = seen[centre[0][inside], centre[1][inside]]

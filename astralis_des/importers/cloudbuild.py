@@ -49,9 +49,12 @@ class Blocks:
 def build(cloud: Cloud, found: Survey, ground: Ground, origin: FloatArray,
           shape: tuple[int, int], voxel: float, fill: str, opts: ImportOptions,
           rng: np.random.Generator) -> Blocks:
-    seen_cell = max(SEEN_CELL, raster_cell(voxel, np.array(shape) * voxel),
-                    2 * found.spacing)
-    close = min(max(math.ceil(found.spacing / voxel), 1), MAX_CLOSE)
+    seen_cell = max(SEEN_CELL, voxel, 2 * found.spacing,
+                    raster_cell(voxel, np.array(shape) * voxel))
+    # A closing as wide as the points are apart fills the holes between the returns of one
+    # roof; points further apart than MAX_CLOSE voxels leave holes no closing should fill.
+    gap = max(math.ceil(found.spacing / voxel), 1)
+    close = gap if gap <= MAX_CLOSE else 1
     sample = _sample(found.kept, opts.cloud_points, rng)
     picked_xyz = np.empty((len(sample), 3), dtype=np.float32)
     picked_rgb = np.empty((len(sample), 3), dtype=np.uint8) if cloud.colors is not None \

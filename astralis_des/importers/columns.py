@@ -2,7 +2,7 @@
 highest point (an aerial scanner sees the roof, not what is under it).
 
 The highest point of each column is folded in chunk by chunk: in a grid when the site's grid
-is small (at most ``MAX_RASTER`` cells), else by the columns' keys, so that a kilometre-wide
+is small (at most ``COLUMN_GRID`` cells), else by the columns' keys, so that a kilometre-wide
 site at a fine voxel costs what its points hold. A grey closing of ``size`` cells fills the
 holes that the scan's spacing leaves between the columns of one roof; on a large site it runs
 tile by tile over the tiles that hold points.
@@ -16,11 +16,11 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 
-from astralis_des.importers.density import MAX_RASTER
 from astralis_des.importers.sparse import IntArray, Keyed, pack, unpack
 from astralis_des.world.geometry import FloatArray
 
 TILE = 1024  # cells a side of a tile of the closing
+COLUMN_GRID = 1 << 24  # cells of the largest grid of columns (16 M: 128 MB)
 
 
 class Columns:
@@ -28,7 +28,7 @@ class Columns:
 
     def __init__(self, shape: tuple[int, int]) -> None:
         self.shape = shape
-        self.grid = np.zeros(shape) if math.prod(shape) <= MAX_RASTER else None
+        self.grid = np.zeros(shape) if math.prod(shape) <= COLUMN_GRID else None
         self.keyed = Keyed("max")
 
     def add(self, cells: IntArray, heights: FloatArray) -> None:
@@ -61,9 +61,14 @@ def _closed_by_tiles(i: IntArray, j: IntArray, heights: FloatArray, shape: tuple
     halo = size
     ti, tj = i // TILE, j // TILE
     stride = shape[1] // TILE + 2
-    tiles = np.unique(ti * stride + tj)
-    near = {(int(t // stride) + a, int(t % stride) + b) for t in tiles
-            for a in (-1, 0, 1) for b in (-1, 0, 1)}
+    near: set[tuple[int, int]] = set()
+    for a in (-1, 0, 1):  # a column within the halo of a tile's edge closes into that tile too
+        for b in (-1, 0, 1):
+            reach = (((i % TILE < halo) if a < 0 else (i % TILE >= TILE - halo)) if a else
+                     np.ones(len(i), dtype=bool)) & \
+                (((j % TILE < halo) if b < 0 else (j % TILE >= TILE - halo)) if b else True)
+            keys = np.unique((ti[reach] + a) * stride + tj[reach] + b)
+            near.update((int(k // stride), int(k % stride)) for k in keys)
     order = np.lexsort((tj, ti))
     flat = ti[order] * stride + tj[order]
     found: list[tuple[IntArray, IntArray, FloatArray]] = []

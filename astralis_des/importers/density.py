@@ -26,7 +26,7 @@ SPARSE = 1.0  # m: a cloud spaced wider than this is coarse (under one point per
 STRAY_SHARE = 0.01  # a cluster with fewer of the points than this is left out
 GAP_XY = (100.0, 50.0)  # m, and spacings: the emptiness that cuts a stray off, across
 GAP_Z = 50.0  # m up or down
-MAX_RASTER = 1 << 24  # cells in any 2-D grid over the site (16 M: 128 MB of float64)
+MAX_RASTER = 1 << 22  # cells in a 2-D grid over the site (4 M: 32 MB of float64)
 
 
 def spacing(xy: FloatArray, points: int) -> tuple[float, float]:
