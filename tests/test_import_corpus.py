@@ -109,7 +109,9 @@ OUTCOMES: dict[str, World | Refused] = {
     "pcd/utm17_comma.pcd": Refused(TOO_SMALL + '10 points over 4.3 x 2.0 m'),
     "pcd/utm17_space.pcd": Refused(TOO_SMALL + '10 points over 4.3 x 2.0 m'),
     "pcd/utm17_tab.pcd": Refused(TOO_SMALL + '10 points over 4.3 x 2.0 m'),
-    "ply/issue_2421.ply": Refused(TOO_SMALL + '1 point over 0.0 x 0.0 m'),
+    "ply/issue_2421.ply": Refused(  # z = 1,234,567,890.12345
+        "coordinates reach 1.23e+09 m, no place on the Earth: check the file's scale and "
+        "offset, or its units (--units, --crs)"),
     "ply/mesh.ply": Refused(
         MESH_TOO_SMALL),
     "ply/mesh_fixed.ply": Refused(

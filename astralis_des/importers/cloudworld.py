@@ -65,11 +65,11 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions, fmt: str) -> Buil
     classified = found.ground_class / found.kept if classes is not None and classes.any() \
         else None  # class 0 throughout: never classified
     share = built.ground_points / found.kept
-    source = {"kind": "cloud", "points": len(cloud) if cloud.held is None else cloud.held,
-              "dropped": found.dropped, "units": frame.note, "scale": round(frame.horizontal,
-                                                                           9),
-              "up": "z", "offset": offset, "ground": ground.method,
-              "ground_share": round(share, 4), "relief": round(ground.relief, 2),
+    held = len(cloud) if cloud.held is None else cloud.held
+    source = {"kind": "cloud", "points": held, "dropped": found.dropped, "units": frame.note,
+              "scale": round(frame.horizontal, 9), "up": "z", "offset": offset,
+              "ground": ground.method, "ground_share": round(share, 4),
+              "relief": round(ground.relief, 2),
               "origin": _geodetic(frame.wkt, offset, frame.vertical)}
     if found.strays:
         source["strays"] = found.strays
@@ -87,7 +87,8 @@ def _voxel(found: Survey, opts: ImportOptions, path: Path, notes: list[str]) -> 
     """The voxel: as given (unless far finer than the points, or too fine for the site), else
     the finest nice size no finer than the points' spacing."""
     span = float(np.max(found.hi[:2] - found.lo[:2])) + 2 * opts.margin
-    coarsest = span / MAX_INDEX  # boxes are stored as uint16 voxel indices
+    rise = float(found.hi[2] - found.lo[2])  # the most a point can stand above the ground
+    coarsest = max(span, rise) / MAX_INDEX  # boxes are stored as uint16 voxel indices
     spaced = (f"one point per {found.spacing:.3g} m: {found.kept:,} points over the "
               f"{found.area:,.0f} m^2 they cover")
     if opts.voxel is not None:
@@ -100,7 +101,8 @@ def _voxel(found: Survey, opts: ImportOptions, path: Path, notes: list[str]) -> 
         return float(opts.voxel)
     voxel = choose_voxel(max(found.spacing, coarsest))
     if coarsest > voxel:
-        raise InputError(f"the cloud spans {span / 1000:,.0f} km ({found.kept:,} points): "
+        raise InputError(f"the cloud spans {max(span, rise) / 1000:,.0f} km ({found.kept:,} "
+                         "points): "
                          f"more than a world holds at {voxel:g} m voxels (65,535 a side); "
                          "crop it first", file=path)
     how = "the finest no finer than the points" if voxel >= found.spacing else \

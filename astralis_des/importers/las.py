@@ -1,59 +1,37 @@
 """LAS, LAZ and COPC: every version (1.0 to 1.4) and point format (0 to 10), streamed.
 
-The header is checked against the file first (:mod:`.lasfile`): a truncated file, a broken VLR
-or EVLR count, a point count the file cannot hold or a chunk table that is lost or unsound is
-found before laspy reads a point. Points are streamed in chunks (laspy's ``chunk_iterator``)
-and kept as the file stores them, so a cloud costs 12 bytes a point, plus its classes and
-colours; beyond ``max_points`` every k-th point is kept. A LAZ is read with lazrs, and, where
-lazrs cannot (LASzip's point-wise compressor of version 1.x, or an error), with laspy's other
-backend, laszip; a LAZ cut short reads its whole chunks. A COPC whose points are more than
-needed is read level by level down to the deepest level that fits, its octree checked first.
+The file's bytes are checked first (:mod:`.lasfile`, :mod:`.lazfile`), so that what would
+make laspy or lazrs loop, abort or ask for the memory of a claimed count is mended or refused
+before a point is read. Points are streamed (laspy's ``chunk_iterator``) and kept as the file
+stores them, 12 bytes a point plus classes and colours; beyond ``max_points`` every k-th point
+is kept. A LAZ is read with lazrs, or laszip (LASzip 1.x's point-wise compressor, or an
+error); one cut short reads its whole chunks. A COPC of more points than needed is read down
+to the level that fits.
 """
 
 from __future__ import annotations
 
 import logging
 import math
-import re
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from astralis_des.errors import InputError
-from astralis_des.importers.lasfile import (
-    POINTWISE,
-    VARIABLE,
-    Layout,
-    Mended,
-    Node,
-    copc_nodes,
-    counting,
-    layout,
-    laz_tail,
-    problems,
-)
+from astralis_des.importers.lasfile import VARIABLE, Layout, Mended, counting, layout, problems
+from astralis_des.importers.lasunits import las_crs, las_units
+from astralis_des.importers.lazfile import POINTWISE, Node, copc_nodes, laz_of, laz_tail
 from astralis_des.importers.pointcloud import library_error, partial_hint
-from astralis_des.importers.source import (
-    FOOT,
-    US_SURVEY_FOOT,
-    Cloud,
-    ReadRequest,
-    max_points,
-    reader,
-)
+from astralis_des.importers.source import Cloud, ReadRequest, max_points, reader
 
 log = logging.getLogger(__name__)
 
 CHUNK = 1_000_000  # points decompressed at a time
 PARALLEL_BYTES = 1 << 28  # the biggest decompressed chunk lazrs's parallel reader may hold
-# EPSG codes of linear units in a GeoTIFF key directory (ProjLinearUnitsGeoKey, 3076).
-LINEAR_UNITS = {9001: ("m", 1.0), 9002: ("ft", FOOT), 9003: ("US survey ft", US_SURVEY_FOOT)}
-PROJ_LINEAR_UNITS, VERTICAL_UNITS = 3076, 4099
-_WKT_UNIT = re.compile(r'(?:LENGTH)?UNIT\[\s*"([^"]+)"\s*,\s*([0-9.eE+-]+)')
-_ANGULAR = ("degree", "radian", "grad", "arc")
 _PASSING = (KeyboardInterrupt, SystemExit, GeneratorExit)
 
 
@@ -64,6 +42,8 @@ def read_las(path: Path, request: ReadRequest) -> Cloud:
     keep = max_points(request)
     with path.open("rb") as raw:
         found = layout(path, raw)
+        if found.compressed:
+            found = replace(found, laz=laz_of(path, raw, found))
         copc = found.is_copc and found.laz is not None and found.count > keep
         octree = copc_nodes(path, raw, found) if copc else None
     backends = _backends(path, found)
@@ -82,8 +62,8 @@ def read_las(path: Path, request: ReadRequest) -> Cloud:
                      f"the {count:,} its header announces")
     cloud.notes[:0] = notes
     with _laspy_quiet():
-        cloud.crs_scale, cloud.crs_vertical, cloud.crs_note = _las_units(header)
-        cloud.crs_wkt = _las_crs(header)
+        cloud.crs_scale, cloud.crs_vertical, cloud.crs_note = las_units(header)
+        cloud.crs_wkt = las_crs(header)
     cloud.resolution = float(min(header.scales[:2]))
     return cloud
 
@@ -111,8 +91,8 @@ def _backends(path: Path, found: Layout) -> tuple[Any, ...]:
         raise InputError("a LAZ file needs one of laspy's LAZ backends: pip install lazrs",
                          file=path)
     sequential = [b for b in available if b == laspy.LazBackend.Lazrs]
-    if found.laz.chunks is None and sequential:
-        return tuple(sequential)
+    if found.laz.chunks is None and found.laz.whole is None and sequential:
+        return tuple(sequential)  # an empty table of our own: chunk after chunk
     if found.laz.biggest * found.record_length > PARALLEL_BYTES:
         return tuple(sequential + laszip)
     return tuple(lazrs + laszip)
@@ -125,11 +105,19 @@ def _chunks_checked(path: Path, found: Layout, request: ReadRequest) -> Layout:
     laz = found.laz
     if laz is None or laz.compressor == POINTWISE or not found.count:
         return found
+    if laz.chunks is None and laz.whole is None and laz.chunk_size == VARIABLE:
+        # lazrs would panic without a table to say where each chunk ends
+        raise InputError("truncated or damaged: its chunk table cannot be read, and its "
+                         "chunks vary in size, so none can be told apart", file=path)
     capacity = laz.capacity
+    if laz.whole is not None and capacity is not None:  # layered: chunk by chunk, known
+        if found.count > capacity:
+            chunks = len(laz.chunks or ())
+            _short(path, capacity, found.count, request, f"chunk {len(laz.whole) + 1:,} of "
+                   f"{chunks:,} cannot be read" if len(laz.whole) < chunks else "")
+            found = counting(found, capacity)
+        return found if laz.chunks is not None else laz_tail(found)
     if capacity is None:
-        if laz.chunk_size == VARIABLE:
-            raise InputError("truncated or damaged: its chunk table cannot be read, and its "
-                             "chunks vary in size, so none can be told apart", file=path)
         return laz_tail(found)
     if found.count <= capacity:
         return found
@@ -207,13 +195,16 @@ class _Points:
 def _read_stream(path: Path, found: Layout, backends: tuple[Any, ...], keep: int,
                  request: ReadRequest) -> tuple[Cloud, Any]:
     """Every point in file order (every k-th beyond ``keep``), with the first backend that
-    reads the file; a failure after points were read is the file's, not the backend's."""
+    reads the file; a failure after points were read is the file's, not the backend's. A
+    LAZ whose chunk table is lost may hold far fewer points than its header says: room for
+    them is made as they come."""
+    import laspy
+
     stride = max(math.ceil(found.count / keep), 1) if found.count else 1
-    names = _dimensions(found)
+    names = set(laspy.PointFormat(found.point_format).dimension_names)
     batch, whole = _batches(found)
-    trusted = found.laz is None or found.laz.chunks is not None
-    room = math.ceil(found.count / stride) if trusted else math.ceil(min(found.count, CHUNK)
-                                                                     / stride)
+    trusted = found.laz is None or found.laz.capacity is not None
+    room = math.ceil((found.count if trusted else min(found.count, CHUNK)) / stride)
     failure: BaseException | None = None
     for backend in backends or (None,):
         points = _Points(room, stride, {"red", "green", "blue"} <= names,
@@ -284,12 +275,6 @@ def _nth(k: int) -> str:
     return f"{k}{'th' if 10 <= k % 100 <= 20 else {1: 'st', 2: 'nd', 3: 'rd'}.get(k % 10, 'th')}"
 
 
-def _dimensions(found: Layout) -> set[str]:
-    import laspy
-
-    return set(laspy.PointFormat(found.point_format).dimension_names)
-
-
 def _reason(path: Path, exc: BaseException) -> str:
     """The library's complaint, shortened: "truncated ..." when the data ended early."""
     message = library_error(path, "LAS", _exception(exc)).message
@@ -325,8 +310,11 @@ def _laspy_quiet() -> Iterator[None]:
 def _read_copc(path: Path, found: Layout, octree: tuple[float, list[Node]], keep: int,
                request: ReadRequest) -> tuple[Cloud, Any]:
     """The coarse levels of a COPC octree, down to the deepest whose points (with all above
-    it) number at most ``keep`` (the root level thinned when even it is more): the cloud
-    thinned evenly in space, the rest never read."""
+    it) number at most ``keep`` (the root level thinned when even it is more), one level at
+    a time by laspy's ``CopcReader``: the cloud thinned evenly in space, the rest never
+    read."""
+    import laspy
+
     spacing, nodes = octree
     per_level: dict[int, int] = {}
     for node in nodes:
@@ -335,111 +323,29 @@ def _read_copc(path: Path, found: Layout, octree: tuple[float, list[Node]], keep
     for level in sorted(per_level):
         if total + per_level[level] > keep and levels:
             break
-        total += per_level[level]
-        levels = level + 1
+        total, levels = total + per_level[level], level + 1
     stride = max(math.ceil(total / keep), 1)
     try:
-        cloud, header = _copc_levels(path, found, [n for n in nodes if n.level < levels],
-                                     total, stride, request)
-    except (InputError, *_PASSING):
+        with _laspy_quiet(), path.open("rb") as raw, laspy.CopcReader(
+                Mended(raw, found.patches)) as copc:
+            copc.header.read_evlrs(copc.source)  # the CRS may be in one; CopcReader skips them
+            names = set(copc.header.point_format.dimension_names)
+            points = _Points(math.ceil(total / stride), stride, {"red", "green", "blue"} <= names,
+                             "classification" in names)
+            points.header = copc.header
+            for level in range(levels):
+                points.add(copc.query(level=level))
+                if request.progress is not None:
+                    request.progress(points.read, total)
+    except _PASSING:
         raise
     except BaseException as exc:  # lazrs's panics are BaseExceptions
         raise library_error(path, "COPC", _exception(exc)) from None
+    cloud = points.cloud()
     cloud.held = found.count
     thinned = f", every {_nth(stride)} point of them" if stride > 1 else ""
     cloud.notes.append(f"COPC: read octree levels 0 to {levels - 1} of {max(per_level) + 1} "
                        f"({len(cloud):,} of {found.count:,} points{thinned}, spaced about "
                        f"{spacing / 2 ** (levels - 1):.3g} file units): within --max-points "
                        f"{keep:,}")
-    return cloud, header
-
-
-def _copc_levels(path: Path, found: Layout, nodes: list[Node], total: int, stride: int,
-                 request: ReadRequest) -> tuple[Cloud, Any]:
-    """The points of ``nodes``, level by level, each level's chunks decompressed together."""
-    import laspy
-    import lazrs
-
-    assert found.laz is not None
-    with _laspy_quiet(), path.open("rb") as raw, path.open("rb") as head, laspy.open(
-            Mended(head, found.patches), laz_backend=()) as opened:
-        header = opened.header
-        names = set(header.point_format.dimension_names)
-        points = _Points(math.ceil(total / stride), stride, {"red", "green", "blue"} <= names,
-                         "classification" in names)
-        points.header = header
-        for level in sorted({n.level for n in nodes}):
-            chosen = sorted((n for n in nodes if n.level == level), key=lambda n: n.offset)
-            data = bytearray()
-            for node in chosen:
-                raw.seek(node.offset)
-                data += raw.read(node.size)
-            out = np.zeros(sum(n.points for n in chosen) * header.point_format.size, np.uint8)
-            lazrs.decompress_points_with_chunk_table(
-                bytes(data), found.laz.record, out, [(n.points, n.size) for n in chosen])
-            points.add(laspy.PackedPointRecord.from_buffer(out, header.point_format))
-            if request.progress is not None:
-                request.progress(points.read, total)
-    return points.cloud(), header
-
-
-def _las_crs(header: Any) -> str | None:
-    """The header's coordinate system as WKT (from its WKT or GeoTIFF keys, by laspy and
-    pyproj), or None."""
-    try:
-        crs = header.parse_crs()
-    except Exception:  # keys or WKT pyproj cannot read: no georeference
-        return None
-    return None if crs is None else str(crs.to_wkt())
-
-
-def _las_units(header: Any) -> tuple[float | None, float | None, str]:
-    """Metres per horizontal and vertical unit from the GeoTIFF keys, else the WKT (in a VLR
-    or, in LAS 1.4, an EVLR)."""
-    records = [*header.vlrs, *(header.evlrs or ())]
-    for vlr in records:
-        keys = {k.id: k.value_offset for k in getattr(vlr, "geo_keys", [])}
-        if PROJ_LINEAR_UNITS in keys and keys[PROJ_LINEAR_UNITS] in LINEAR_UNITS:
-            name, scale = LINEAR_UNITS[keys[PROJ_LINEAR_UNITS]]
-            vertical = LINEAR_UNITS.get(keys.get(VERTICAL_UNITS, -1), (None, None))[1]
-            return (scale, vertical, f"{name} (EPSG {keys[PROJ_LINEAR_UNITS]}, "
-                    "from the header's GeoTIFF keys)")
-    for vlr in records:
-        text = getattr(vlr, "string", None)
-        if isinstance(text, bytes):
-            text = text.decode("ascii", "replace")
-        units = _wkt_units(text) if isinstance(text, str) else None
-        if units is not None:
-            return units
-    return None, None, ""
-
-
-def _wkt_units(text: str) -> tuple[float, float | None, str] | None:
-    """Metres per unit of a WKT's projected system (and of its vertical one) as pyproj reads
-    them; from its UNIT keywords when pyproj cannot read it (the first one not of angles)."""
-    from pyproj import CRS
-
-    try:
-        crs = CRS.from_wkt(text)
-    except Exception:  # pyproj's CRSError, or worse for a damaged WKT
-        linear = [(n, float(f)) for n, f in _WKT_UNIT.findall(text)
-                  if not any(a in n.lower() for a in _ANGULAR) and _is_number(f)]
-        if not linear:
-            return None
-        (name, scale), vertical = linear[0], linear[1][1] if len(linear) > 1 else None
-        return scale, vertical, f"{name} ({scale:g} m, from the header's WKT)"
-    parts = crs.sub_crs_list if crs.is_compound else [crs]
-    if not parts or not parts[0].is_projected or not parts[0].axis_info:
-        return None  # degrees: projected where the frame is made
-    axis = parts[0].axis_info[0]
-    scale = float(axis.unit_conversion_factor)
-    heights = parts[1].axis_info if len(parts) > 1 else []
-    vertical = float(heights[0].unit_conversion_factor) if heights else None
-    return scale, vertical, f"{axis.unit_name} ({scale:g} m, from the header's WKT)"
-
-
-def _is_number(text: str) -> bool:
-    try:
-        return math.isfinite(float(text))
-    except ValueError:
-        return False
+    return cloud, points.header

@@ -1,19 +1,18 @@
 """What a LAS/LAZ file's own bytes say before laspy reads it: its header checked against the
-file's size, its VLRs and EVLRs walked, its LASzip VLR and chunk table checked, and a file
-object that mends a header laspy would choke on.
+file's size, its VLRs and EVLRs walked (a LAZ's LASzip VLR and chunks: :mod:`.lazfile`), and
+a file object that mends a header laspy would choke on.
 
-Real files break the specification in ways laspy and its LAZ backends do not survive: a VLR
-count of a billion (laspy reads VLRs until memory runs out), more VLRs than fit before the
-points, EVLRs past the end of the file, a chunk table that claims four billion chunks (lazrs
-asks for the memory at once and the process aborts), or none at all (a LAZ cut short).
-:func:`layout` finds these from the header, the VLR headers and the chunk table alone, and
-:class:`Mended` hands laspy a header with the counts that fit and, for a LAZ whose chunk
-table is lost, an empty table of its own.
+Real files break the specification in ways laspy does not survive: a VLR count of a billion
+(laspy reads VLRs until memory runs out), more VLRs than fit before the points, EVLRs past the
+end of the file or longer than it (laspy asks for the memory of the length it reads), a LAS
+1.4 header with only its legacy point count. :func:`layout` finds these from the header and
+the VLR and EVLR headers alone, and :class:`Mended` hands laspy a header with counts that fit.
 """
 
 from __future__ import annotations
 
 import io
+import math
 import struct
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -31,11 +30,7 @@ VLR_COUNT_AT, FORMAT_AT, LEGACY_COUNT_AT = 100, 104, 107
 EVLR_START_AT, EVLR_COUNT_AT, COUNT_AT = 235, 243, 247
 LASZIP = (b"laszip encoded", 22204)
 COPC_INFO = (b"copc", 1)
-POINTWISE = 1  # LASzip's compressor of version 1.x: no chunks
-CHUNKED = (2, 3)  # LASzip's point-wise and layered chunked compressors
-VARIABLE = 0xFFFFFFFF  # a chunk size that says each chunk's count is in the chunk table
-LASZIP_FIXED = struct.Struct("<HHBBHIIqqH")  # the LASzip VLR before its items (34 bytes)
-ENTRY = struct.Struct("<iiiiQii")  # a COPC hierarchy entry: key, offset, bytes, points
+VARIABLE = 0xFFFFFFFF  # a LASzip chunk size that says each chunk's count is in the chunk table
 
 
 @dataclass(frozen=True)
@@ -47,10 +42,15 @@ class Laz:
     chunk_size: int  # points a chunk; VARIABLE: as the chunk table says
     record: bytes  # the LASzip VLR's data, for lazrs
     chunks: tuple[tuple[int, int], ...] | None  # (points, bytes) a chunk, when the table reads
+    layers: int = 0  # layers a chunk of a LAS 1.4 point format has (0: not layered)
+    whole: tuple[tuple[int, int], ...] | None = None  # layered: (points, bytes) of each sound
+    # chunk from the first, found from the chunks themselves
 
     @property
     def capacity(self) -> int | None:
-        """The most points the chunk table allows (each fixed-size chunk full)."""
+        """The most points the chunks hold (each fixed-size chunk full, when not layered)."""
+        if self.whole is not None:
+            return sum(points for points, _ in self.whole)
         if self.chunks is None:
             return None
         if self.chunk_size == VARIABLE:
@@ -60,9 +60,10 @@ class Laz:
     @property
     def biggest(self) -> int:
         """Points in the biggest chunk (as many as a fixed-size chunk may hold)."""
-        if self.chunk_size != VARIABLE or not self.chunks:
+        chunks = self.whole if self.whole is not None else self.chunks
+        if self.chunk_size != VARIABLE or not chunks:
             return self.chunk_size
-        return max(points for points, _ in self.chunks)
+        return max(points for points, _ in chunks)
 
 
 @dataclass(frozen=True)
@@ -84,7 +85,7 @@ class Layout:
     evlrs_fit: bool  # the EVLRs start after the points and before the end of the file
     patches: dict[int, bytes] = field(default_factory=dict)  # header bytes laspy should see
     evlrs_whole: int = 0  # EVLRs that fit in the file, one after another
-    laz: Laz | None = None  # a compressed file's LASzip VLR and chunk table
+    laz: Laz | None = None  # a compressed file's LASzip VLR and chunks (:mod:`.lazfile`)
 
     @property
     def whole_points(self) -> int:
@@ -103,7 +104,7 @@ class Layout:
 
 def layout(path: Path, raw: BinaryIO) -> Layout:
     """The header of ``raw`` (a LAS or LAZ file) and its VLRs, or an :class:`InputError`
-    that names what is broken."""
+    that names what is broken (a LAZ's ``laz`` is :func:`.lazfile.laz_of`'s to add)."""
     size = raw.seek(0, io.SEEK_END)
     raw.seek(0)
     head = raw.read(375)
@@ -117,10 +118,10 @@ def layout(path: Path, raw: BinaryIO) -> Layout:
     header_size, offset, vlr_count = struct.unpack_from("<HII", head, 94)
     format_byte, record_length = head[FORMAT_AT], struct.unpack_from("<H", head, 105)[0]
     count = struct.unpack_from("<I", head, LEGACY_COUNT_AT)[0]
-    evlr_start, evlr_count = 0, 0
-    if version >= (1, 4) and header_size >= 375 and len(head) >= 375:
-        evlr_start, evlr_count = struct.unpack_from("<QI", head, EVLR_START_AT)
-        count = struct.unpack_from("<Q", head, COUNT_AT)[0] or count
+    evlr_start, evlr_count, wide = 0, 0, count
+    if version[1] >= 4 and header_size >= 375 and len(head) >= 375:  # as laspy reads it
+        evlr_start, evlr_count, wide = struct.unpack_from("<QIQ", head, EVLR_START_AT)
+        count = wide or count  # some writers fill the legacy count only
     point_format = format_byte & 0x3F
     if point_format not in POINT_SIZES:
         raise InputError(f"not a readable LAS file (point format {point_format}; LAS has 0 to "
@@ -132,8 +133,17 @@ def layout(path: Path, raw: BinaryIO) -> Layout:
     if not HEADER_MIN <= header_size <= offset <= size:
         raise InputError(f"not a readable LAS file (header of {header_size} bytes, points "
                          f"from byte {offset:,}, in a file of {size:,})", file=path)
+    scales, offsets = struct.unpack_from("<3d", head, 131), struct.unpack_from("<3d", head, 155)
+    reach = [abs(s) * 2.0**31 + abs(o) for s, o in zip(scales, offsets, strict=True)]
+    if not all(math.isfinite(r) for r in reach):  # coordinates would overflow, or be NaN
+        raise InputError("not a readable LAS file (its scale factors "
+                         f"{', '.join(f'{s:g}' for s in scales)} and offsets "
+                         f"{', '.join(f'{o:g}' for o in offsets)} give no finite coordinates)",
+                         file=path)
     vlrs = _walk_vlrs(raw, header_size, offset, vlr_count)
     patches: dict[int, bytes] = {}
+    if wide != count:  # laspy reads the 64-bit count alone
+        patches[COUNT_AT] = struct.pack("<Q", count)
     if len(vlrs) != vlr_count:
         patches[VLR_COUNT_AT] = struct.pack("<I", len(vlrs))
     compressed = bool(format_byte & 0xC0)  # as LASzip reads it: bit 6 marks old LASzip files
@@ -143,10 +153,9 @@ def layout(path: Path, raw: BinaryIO) -> Layout:
     whole = _walk_evlrs(raw, evlr_start, size, evlr_count) if evlrs_fit else 0
     if evlr_count and whole != evlr_count:
         patches[EVLR_COUNT_AT] = struct.pack("<I", whole)
-    found = Layout(version, header_size, offset, point_format, record_length, count,
-                   compressed, size, tuple(vlrs), vlr_count, evlr_start, evlr_count,
-                   evlrs_fit, patches, whole)
-    return replace(found, laz=_laz(path, raw, found)) if compressed else found
+    return Layout(version, header_size, offset, point_format, record_length, count,
+                  compressed, size, tuple(vlrs), vlr_count, evlr_start, evlr_count, evlrs_fit,
+                  patches, whole)
 
 
 def _walk_vlrs(raw: BinaryIO, start: int, end: int, claimed: int
@@ -181,90 +190,12 @@ def _walk_evlrs(raw: BinaryIO, start: int, end: int, claimed: int) -> int:
     return whole
 
 
-def _laz(path: Path, raw: BinaryIO, found: Layout) -> Laz:
-    """The LASzip VLR of a compressed file, checked against its header, and its chunk table
-    when the table is sound."""
-    where = found.vlr(*LASZIP)
-    if where is None:
-        raise InputError("not a readable LAZ file (its points are compressed, but it has no "
-                         "LASzip VLR to say how)", file=path)
-    raw.seek(where - VLR_HEADER + 20)
-    length = struct.unpack("<H", raw.read(2))[0]
-    raw.seek(where)
-    record = raw.read(length)
-    items = struct.unpack_from("<H", record, 32)[0] if len(record) >= LASZIP_FIXED.size else -1
-    if items < 1 or len(record) < LASZIP_FIXED.size + 6 * items:
-        raise InputError(f"not a readable LAZ file (its LASzip VLR of {len(record)} bytes is "
-                         "too short for what it describes)", file=path)
-    compressor, _coder, major, _, _, _, chunk_size, *_ = LASZIP_FIXED.unpack_from(record)
-    sizes = sum(struct.unpack_from("<HHH", record, 34 + 6 * i)[1] for i in range(items))
-    if compressor not in (POINTWISE, *CHUNKED) or (chunk_size == 0 and compressor != POINTWISE):
-        raise InputError(f"not a readable LAZ file (its LASzip VLR names compressor "
-                         f"{compressor} with chunks of {chunk_size:,} points)", file=path)
-    if sizes != found.record_length:
-        raise InputError(f"not a readable LAZ file (its LASzip VLR describes points of {sizes} "
-                         f"bytes, its header {found.record_length})", file=path)
-    chunks = _chunk_table(raw, found, record) if compressor in CHUNKED else None
-    return Laz(compressor, major, chunk_size, bytes(record), chunks)
-
-
-def _chunk_table(raw: BinaryIO, found: Layout, record: bytes
-                 ) -> tuple[tuple[int, int], ...] | None:
-    """The chunk table as (points, bytes) a chunk, or None when it is lost or unsound: its
-    offset outside the file, or more chunks than bytes, or chunks that overrun it."""
-    raw.seek(found.offset)
-    start = found.offset + 8
-    data = raw.read(8)
-    at = struct.unpack("<q", data)[0] if len(data) == 8 else -1
-    if at < start and found.size >= start + 8:  # the writer could not seek back: at the end
-        raw.seek(found.size - 8)
-        at = struct.unpack("<q", raw.read(8))[0]
-    if not start <= at <= found.size - 8:
-        return None
-    raw.seek(at)
-    _version, number = struct.unpack("<II", raw.read(8))
-    if number == 0 or number > at - start:  # each chunk takes a byte at least
-        return None
-    try:
-        import lazrs
-
-        raw.seek(found.offset)
-        table = tuple((int(p), int(b)) for p, b in lazrs.read_chunk_table(raw, lazrs.LazVlr(
-            record)))
-    except ImportError:
-        return None
-    except BaseException as exc:  # lazrs's panics are BaseExceptions
-        if isinstance(exc, (KeyboardInterrupt, SystemExit)):
-            raise
-        return None
-    if any(p <= 0 or b <= 0 for p, b in table) or sum(b for _, b in table) > at - start:
-        return None
-    return table
-
-
-def laz_tail(found: Layout) -> Layout:
-    """``found`` with an empty chunk table of its own, one byte past the end of the file: a
-    LAZ whose table is lost (cut short) then reads chunk after chunk, as far as it goes."""
-    tail = found.size + 1
-    patches = dict(found.patches)
-    patches[found.offset] = struct.pack("<q", tail)
-    patches[tail] = struct.pack("<II", 0, 0)
-    return replace(found, patches=patches)
-
-
-def laszip_compressor(raw: BinaryIO, where: int) -> tuple[int, int]:
-    """(compressor, LASzip version major) of the LASzip VLR whose data starts at ``where``."""
-    raw.seek(where)
-    compressor, _coder, major = struct.unpack("<HHB", raw.read(5))
-    return compressor, major
-
-
 def counting(found: Layout, count: int) -> Layout:
     """``found`` with its header's point count mended to ``count`` (the points a truncated
     file holds in full)."""
     patches = dict(found.patches)
     patches[LEGACY_COUNT_AT] = struct.pack("<I", count if count < 2**32 else 0)
-    if found.version >= (1, 4) and found.header_size >= 375:
+    if found.version[1] >= 4 and found.header_size >= 375:
         patches[COUNT_AT] = struct.pack("<Q", count)
     return replace(found, count=count, patches=patches)
 
@@ -272,6 +203,9 @@ def counting(found: Layout, count: int) -> Layout:
 def problems(found: Layout) -> list[str]:
     """What :class:`Mended` mends, for the import's notes."""
     said = []
+    if COUNT_AT in found.patches:
+        said.append(f"the header's 64-bit point count is 0, its legacy count {found.count:,}: "
+                    "read those")
     if VLR_COUNT_AT in found.patches:
         said.append(f"the header counts {found.vlrs_claimed:,} VLRs, {len(found.vlrs)} fit "
                     "before the points: read those")
@@ -282,67 +216,6 @@ def problems(found: Layout) -> list[str]:
         said.append(f"the header counts {found.evlrs_claimed:,} EVLRs, {found.evlrs_whole} "
                     "fit in the file: read those")
     return said
-
-
-@dataclass(frozen=True)
-class Node:
-    """A COPC octree node that holds points: its level, where its LAZ chunk is, its bytes and
-    its points."""
-
-    level: int
-    offset: int
-    size: int
-    points: int
-
-
-def copc_nodes(path: Path, raw: BinaryIO, found: Layout) -> tuple[float, list[Node]]:
-    """The spacing of a COPC file's root level and the nodes of its octree, walked from the
-    root page as laspy walks it (a node's children are looked for under it only), each page
-    read once: a page read twice (a loop), or a node outside the file, is an
-    :class:`InputError`."""
-    where = found.vlr(*COPC_INFO)
-    raw.seek(where or 0)
-    info = raw.read(160)
-    if where is None or len(info) < 160:
-        raise InputError("not a readable COPC file (its COPC info VLR is too short)", file=path)
-    spacing, root_at, root_size = struct.unpack_from("<dQQ", info, 32)
-    entries: dict[tuple[int, ...], tuple[int, int, int]] = {}
-    pages: set[int] = set()
-
-    def page(at: int, size: int) -> None:
-        if at in pages or size < 0 or at + size > found.size or size % ENTRY.size:
-            raise InputError(f"not a readable COPC file (a hierarchy page of {size:,} bytes at "
-                             f"byte {at:,} of {found.size:,}, or read twice)", file=path)
-        pages.add(at)
-        raw.seek(at)
-        for d, x, y, z, offset, nbytes, points in ENTRY.iter_unpack(raw.read(size)):
-            entries[(d, x, y, z)] = (offset, nbytes, points)
-
-    page(root_at, root_size)
-    nodes: list[Node] = []
-    held = 0
-    todo: list[tuple[int, ...]] = [(0, 0, 0, 0)]
-    while todo:
-        key = todo.pop()
-        offset, nbytes, points = entries.get(key, (0, 0, -2))
-        if points == -1:
-            page(offset, nbytes)
-            todo.append(key)
-            continue
-        if points == -2:  # not in the hierarchy: no points under it
-            continue
-        inside = found.offset < offset and nbytes > 0 and offset + nbytes <= found.size
-        held += max(points, 0)
-        if points < 0 or (points and not inside) or held > found.count:
-            raise InputError(f"not a readable COPC file (octree node {key} holds {points:,} "
-                             f"points in {nbytes:,} bytes at byte {offset:,}; the file has "
-                             f"{found.size:,} bytes and {found.count:,} points)", file=path)
-        if points:
-            nodes.append(Node(key[0], offset, nbytes, points))
-        d, x, y, z = key
-        todo.extend((d + 1, 2 * x + i, 2 * y + j, 2 * z + k)
-                    for i in (0, 1) for j in (0, 1) for k in (0, 1))
-    return spacing, nodes
 
 
 class Mended(io.RawIOBase):

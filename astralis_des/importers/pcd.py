@@ -136,6 +136,10 @@ def _fields(path: Path, keys: dict[str, tuple[list[str], int]], names: list[str]
     if not {"x", "y", "z"} <= {f.name for f in fields}:
         raise InputError(f"no x, y and z fields (found: {', '.join(names)})", file=path,
                          line=names_line)
+    wide = next((f for f in fields if f.name in ("x", "y", "z") and f.count != 1), None)
+    if wide is not None:
+        raise InputError(f"field {wide.name} has COUNT {wide.count}: a coordinate is one value "
+                         "a point", file=path, line=counts_line)
     return fields
 
 

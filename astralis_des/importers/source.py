@@ -49,7 +49,8 @@ class Cloud:
         block = self.xyz[lo:hi]
         if block.dtype.kind == "f" and not self.ref.any() and (self.step == 1).all():
             return np.asarray(block, dtype=np.float64)
-        return np.asarray(block * self.step + self.ref, dtype=np.float64)
+        with np.errstate(over="ignore", invalid="ignore"):  # inf and NaN are left out later
+            return np.asarray(block * self.step + self.ref, dtype=np.float64)
 
 
 @dataclass

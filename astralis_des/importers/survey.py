@@ -22,6 +22,7 @@ from astralis_des.importers.source import Cloud
 from astralis_des.world.geometry import FloatArray
 
 CHUNK = 1 << 20  # points converted at a time
+FARTHEST = 1e8  # m: no coordinate system puts a place on the Earth further out
 BoolArray = NDArray[np.bool_]
 
 
@@ -97,6 +98,7 @@ def survey(cloud: Cloud, units: str, crs: str | None, scale: float,
     if not count:
         raise InputError(f"no point has finite coordinates ({n:,} dropped)")
     metres = Metres(cloud, frame_for(cloud, units, crs, lo_f, hi_f), scale)
+    _on_earth(metres, lo_f, hi_f)
     sample = _sample_rows(finite, SAMPLE)
     space, _ = spacing(_gather(metres, sample)[:, :2], count)
     keep, notes = finite, []
@@ -124,6 +126,19 @@ def survey(cloud: Cloud, units: str, crs: str | None, scale: float,
         if classes is not None else 0
     return Survey(metres, keep, kept, n - count, count - kept, lo_m, hi_m, space, area,
                   ground_class, notes)
+
+
+def _on_earth(metres: Metres, lo: FloatArray, hi: FloatArray) -> None:
+    """Coordinates beyond ``FARTHEST`` metres are no place on the Earth: a header's scale or
+    offset is wrong, or the units are."""
+    if metres.frame.projection is not None:
+        return  # longitude and latitude were checked when the plane was made
+    with np.errstate(over="ignore", invalid="ignore"):
+        corners = metres.frame.metres(np.array([lo, hi]))
+    far = float(np.abs(corners).max())
+    if not np.isfinite(far) or far > FARTHEST:
+        raise InputError(f"coordinates reach {far:.3g} m, no place on the Earth: check the "
+                         "file's scale and offset, or its units (--units, --crs)")
 
 
 def _sample_rows(mask: BoolArray, size: int) -> NDArray[np.int64]:
