@@ -11,15 +11,12 @@ multiplies the cases for a long run. Cases the fuzzer found stay as ``@example``
 from __future__ import annotations
 
 import os
-import signal
 import struct
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
 
 import pytest
+from fuzzing.cases import alarm
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
@@ -74,24 +71,6 @@ def mutate(data: bytes, mutations: list[Mutation]) -> bytes:
     return bytes(out)
 
 
-class Hang(Exception):
-    pass
-
-
-@contextmanager
-def limit(seconds: float) -> Iterator[None]:
-    def fire(_signum: int, _frame: Any) -> None:
-        raise Hang(f"no end in {seconds:g} s")
-
-    old = signal.signal(signal.SIGALRM, fire)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
-
-
 def fuzz(examples: int = EXAMPLES) -> settings:
     # derandomize: the same cases on every run, so that the suite is as reproducible as a run
     return settings(max_examples=int(examples * SCALE), deadline=None, database=None,
@@ -109,7 +88,7 @@ def imports_or_refuses(source: str, mutations: list[Mutation], partial: bool,
     capfd.readouterr()
     began = time.perf_counter()
     try:
-        with limit(LIMIT * 2):
+        with alarm(LIMIT * 2):
             report = import_world(path, folder / "out" / "twin.yaml",
                                   ImportOptions(partial=partial))
     except InputError as refused:

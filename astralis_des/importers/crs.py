@@ -112,18 +112,27 @@ def _from_crs(crs: Any, middle: FloatArray, where: str) -> Frame:
     longitude and latitude (a geographic one); heights from its vertical part, else metres
     for a geographic system and the horizontal unit for a projected one."""
     horizontal = crs.sub_crs_list[0] if crs.is_compound else crs
-    vertical = _vertical_scale(crs)
-    name = horizontal.name
-    if horizontal.is_geographic:
+    units = linear_units(crs)
+    if units is None:
         projection = _plane(horizontal, float(middle[0]), float(middle[1]))
-        return Frame(1.0, vertical or 1.0, f"degrees of {name} ({where}), projected onto a "
-                     "transverse Mercator plane at the cloud's middle", crs.to_wkt(),
-                     projection=projection)
+        return Frame(1.0, _vertical_scale(crs) or 1.0, f"degrees of {horizontal.name} "
+                     f"({where}), projected onto a transverse Mercator plane at the cloud's "
+                     "middle", crs.to_wkt(), projection=projection)
+    scale, vertical, unit = units
+    return Frame(scale, vertical or scale, f"{unit} ({scale:g} m, {horizontal.name}, {where})",
+                 crs.to_wkt())
+
+
+def linear_units(crs: Any) -> tuple[float, float | None, str] | None:
+    """Metres per unit across and up (None: the system does not say) and the unit's name, of
+    a pyproj system in lengths (or the horizontal part of a compound one); None for one in
+    longitude and latitude."""
+    horizontal = crs.sub_crs_list[0] if crs.is_compound else crs
+    if horizontal.is_geographic:
+        return None
     axis = horizontal.axis_info[0] if horizontal.axis_info else None
     scale = float(axis.unit_conversion_factor) if axis is not None else 1.0
-    unit = axis.unit_name if axis is not None else "metre"
-    return Frame(scale, vertical or scale, f"{unit} ({scale:g} m, {name}, {where})",
-                 crs.to_wkt())
+    return scale, _vertical_scale(crs), axis.unit_name if axis is not None else "metre"
 
 
 def _vertical_scale(crs: Any) -> float | None:

@@ -110,7 +110,7 @@ def find_ground(xyz: FloatArray, classification: NDArray[np.uint8] | None, metho
         has_class = classification is not None and bool(np.any(classification == GROUND_CLASS))
         method = "classification" if has_class else "grid"
     origin = xyz[:, :2].min(axis=0)
-    shape = grid_shape(xyz[:, :2].max(axis=0), origin, cell)
+    shape = grid_size(xyz[:, :2].max(axis=0), origin, cell)
     minima = Minima(origin, cell, shape)
     if method == "classification":
         if classification is None or not np.any(classification == GROUND_CLASS):
@@ -121,7 +121,8 @@ def find_ground(xyz: FloatArray, classification: NDArray[np.uint8] | None, metho
     return ground_of(minima, method, rng)
 
 
-def grid_shape(hi: FloatArray, origin: FloatArray, cell: float) -> tuple[int, int]:
+def grid_size(hi: FloatArray, origin: FloatArray, cell: float) -> tuple[int, int]:
+    """Cells of ``cell`` from ``origin`` to the one holding ``hi``."""
     index = np.floor((np.asarray(hi) - origin) / cell).astype(np.int64)
     return int(index[0]) + 1, int(index[1]) + 1
 

@@ -7,6 +7,7 @@ import math
 import re
 from typing import Any
 
+from astralis_des.importers.crs import linear_units
 from astralis_des.importers.source import FOOT, US_SURVEY_FOOT
 
 # EPSG codes of linear units in a GeoTIFF key directory (ProjLinearUnitsGeoKey, 3076).
@@ -62,11 +63,9 @@ def _wkt_units(text: str) -> tuple[float, float | None, str] | None:
         (name, scale), vertical = linear[0], linear[1][1] if len(linear) > 1 else None
         return scale, vertical, f"{name} ({scale:g} m, from the header's WKT)"
     parts = crs.sub_crs_list if crs.is_compound else [crs]
-    if not parts or not parts[0].is_projected or not parts[0].axis_info:
+    units = linear_units(crs) if parts and parts[0].is_projected else None
+    if units is None:
         return None  # degrees: projected where the frame is made
-    axis = parts[0].axis_info[0]
-    scale = float(axis.unit_conversion_factor)
-    heights = parts[1].axis_info if len(parts) > 1 else []
-    vertical = float(heights[0].unit_conversion_factor) if heights else None
-    return scale, vertical, f"{axis.unit_name} ({scale:g} m, from the header's WKT)"
+    scale, vertical, unit = units
+    return scale, vertical, f"{unit} ({scale:g} m, from the header's WKT)"
 

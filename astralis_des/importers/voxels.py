@@ -24,9 +24,18 @@ MAX_VOXELS = 400_000_000  # a dense grid larger than this (bytes) is refused, no
 MAX_INDEX = 65_535  # boxes are stored as uint16 indices
 
 
+def _cells(length: float, voxel: float) -> int:
+    return max(math.ceil(float(length) / voxel - 1e-9), 1)
+
+
+def cells_across(extent: FloatArray, voxel: float) -> tuple[int, int]:
+    """Voxels covering the first two axes of ``extent`` (metres)."""
+    return _cells(extent[0], voxel), _cells(extent[1], voxel)
+
+
 def grid_shape(extent: FloatArray, voxel: float, *, what: str = "the geometry") -> tuple[int, ...]:
     """Cells covering ``extent`` (metres per axis) at ``voxel``; refused when too many."""
-    shape = tuple(max(math.ceil(float(e) / voxel - 1e-9), 1) for e in extent)
+    shape = tuple(_cells(e, voxel) for e in extent)
     cells = math.prod(shape)
     if cells > MAX_VOXELS or max(shape) > MAX_INDEX:
         smallest = voxel * max((cells / MAX_VOXELS) ** (1 / len(shape)),

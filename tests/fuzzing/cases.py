@@ -66,7 +66,8 @@ class Hang(Exception):
 
 
 @contextlib.contextmanager
-def _alarm(limit: float) -> Iterator[None]:
+def alarm(limit: float) -> Iterator[None]:
+    """A :class:`Hang` raised in the main thread after ``limit`` seconds."""
     def fire(_signum: int, _frame: Any) -> None:
         raise Hang(f"no end in {limit:g} s")
 
@@ -132,7 +133,7 @@ def run_case(case: Case, folder: Path, limit: float = 30.0) -> Outcome:
     stdout, stderr = io.StringIO(), io.StringIO()
     t0 = time.perf_counter()
     try:
-        with (_alarm(limit), warnings.catch_warnings(record=True) as caught,
+        with (alarm(limit), warnings.catch_warnings(record=True) as caught,
               contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr)):
             warnings.simplefilter("always")
             code = main(command(case, folder))
