@@ -38,3 +38,59 @@ def test_unknown_backend_suggests() -> None:
     with pytest.raises(InputError) as info:
         make_backend("rey", 2)
     assert str(info.value) == "backend: unknown study backend 'rey'; did you mean 'ray'?"
+
+
+def test_a_cluster_with_token_auth_is_refused_in_one_line_saying_what_to_set(
+        tmp_path: Path) -> None:
+    """A Ray cluster started with RAY_AUTH_MODE=token (Ray's coming default), reached
+    without its token: exit 2 and one line naming RAY_AUTH_MODE and RAY_AUTH_TOKEN (before:
+    a ConnectionError traceback, after Ray's own retry lines)."""
+    import os
+    import shutil
+    import signal
+    import socket
+    import subprocess
+    import sys
+    import tempfile
+    import time
+
+    pytest.importorskip("ray")
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    secret = {"RAY_AUTH_MODE": "token", "RAY_AUTH_TOKEN": "astralis-test-token-0123456789"}
+    short = tempfile.mkdtemp(prefix="ray", dir="/tmp")  # Ray's socket paths must be short
+    head = subprocess.Popen(
+        [str(Path(sys.executable).parent / "ray"), "start", "--head", f"--port={port}",
+         "--num-cpus=1", "--include-dashboard=false", "--disable-usage-stats", "--block",
+         f"--temp-dir={short}"], env={**os.environ, **secret},
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            with socket.socket() as knock:
+                if knock.connect_ex(("127.0.0.1", port)) == 0:
+                    break
+            time.sleep(0.2)
+        plain = {k: v for k, v in os.environ.items() if not k.startswith("RAY_AUTH")}
+        done = subprocess.run(
+            [sys.executable, "-m", "astralis_des.cli", "study", str(ROOT / "studies" /
+             "table5.yaml"), "--scenarios", "2", "--backend", "ray", "--address",
+             f"127.0.0.1:{port}", "--out", str(tmp_path / "study"), "--quiet"],
+            capture_output=True, text=True, env=plain, timeout=120)
+    finally:
+        os.killpg(head.pid, signal.SIGTERM)  # ray start --block stops its processes
+        try:
+            head.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            os.killpg(head.pid, signal.SIGKILL)
+            head.wait()
+        shutil.rmtree(short, ignore_errors=True)
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        f"error: address: cannot use the Ray cluster at 127.0.0.1:{port} (")
+    assert lines[0].endswith("a cluster with token authentication needs RAY_AUTH_MODE=token "
+                             "and its token in RAY_AUTH_TOKEN or RAY_AUTH_TOKEN_PATH "
+                             "(docs/studies.md)")
+    assert not (tmp_path / "study").exists()

@@ -7,15 +7,15 @@ puts the rows back in order.
 from __future__ import annotations
 
 import logging
-import multiprocessing
 from collections.abc import Callable, Generator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 from astralis_des.errors import InputError
-from astralis_des.exits import default_termination
+from astralis_des.physics.quiet import quiet_c_output
 from astralis_des.registry import Registry, UnknownEntry
-from astralis_des.studies.scenarios import ChunkResult, run_chunk
+from astralis_des.studies.pool import WorkerPool
+from astralis_des.studies.scenarios import ChunkResult, failed_scenario, run_chunk
 
 if TYPE_CHECKING:
     from astralis_des.studies.spec import Study
@@ -47,35 +47,10 @@ def make_backend(name: str, workers: int, address: str | None = None) -> Backend
         raise InputError(str(exc), key="backend") from None
 
 
-# -- local: one process, or a process pool ---------------------------------------------------
-_STUDY: Study | None = None  # the study a pool worker runs, set once by its initializer
-
-
-def _take_study(study: Study) -> None:
-    global _STUDY
-    _STUDY = study
-    default_termination()  # the pool ends its workers with SIGTERM: no interrupt there
-
-
-def _chunk_in_worker(job: tuple[list[int], Path | None]) -> ChunkResult:
-    assert _STUDY is not None
-    return run_chunk(_STUDY, *job)
-
-
-_MADE: list[tuple[dict[str, Any], Study]] = []  # a held pool's worker: the last study it made
-
-
-def _changed_chunk_in_worker(job: tuple[dict[str, Any], list[int], Path | None]) -> ChunkResult:
-    """A chunk of ``_STUDY.with_changes(**changes)``, the study made once per worker and run."""
-    assert _STUDY is not None
-    changes, indices, recordings = job
-    if not _MADE or _MADE[0][0] != changes:
-        _MADE[:] = [(changes, _STUDY.with_changes(**changes))]
-    return run_chunk(_MADE[0][1], indices, recordings)
-
-
+# -- local: one process, or a pool of worker processes -----------------------------------
 class LocalBackend:
-    """This process for one worker, else a pool of processes that each get the study once."""
+    """This process for one worker, else a :class:`WorkerPool`: processes that each hold the
+    study, and that are replaced when one dies."""
 
     name = "local"
 
@@ -84,7 +59,7 @@ class LocalBackend:
             raise InputError("the local backend takes no address (it is for ray)",
                              key="address")
         self.workers = max(1, workers)
-        self._held: tuple[Study, Any] | None = None  # the base study and its pool
+        self._held: WorkerPool | None = None
 
     def hold(self, base: Study) -> None:
         """One pool for the runs that follow, its workers holding ``base``: a study made from
@@ -92,33 +67,29 @@ class LocalBackend:
         (free floor, furnished rooms) lasts from one run to the next."""
         self.close()
         if self.workers > 1:
-            pool = multiprocessing.get_context("fork").Pool(
-                self.workers, initializer=_take_study, initargs=(base,))
-            self._held = (base, pool)
+            self._held = WorkerPool(base, self.workers)
 
     def close(self) -> None:
         if self._held is not None:
-            self._held[1].terminate()
-            self._held[1].join()
+            self._held.close()
             self._held = None
 
     def run(self, study: Study, chunks: Sequence[list[int]],
             recordings: Path | None) -> Generator[ChunkResult, None, None]:
-        if self.workers == 1 or len(chunks) == 1:
+        indices = [i for chunk in chunks for i in chunk]
+        if self.workers == 1 or len(indices) == 1:
             for chunk in chunks:
                 yield run_chunk(study, chunk, recordings)
             return
         held = self._held
-        if held is not None and study.origin is not None and study.origin[0] is held[0]:
-            changes = study.origin[1]
-            yield from held[1].imap_unordered(_changed_chunk_in_worker,
-                                              [(changes, c, recordings) for c in chunks])
+        if held is not None and study.origin is not None and study.origin[0] is held.base:
+            yield from held.run(study, study.origin[1], indices, recordings)
             return
-        # Leaving the pool's block terminates its workers, also on Ctrl-C or an error.
-        with multiprocessing.get_context("fork").Pool(
-                min(self.workers, len(chunks)), initializer=_take_study,
-                initargs=(study,)) as pool:
-            yield from pool.imap_unordered(_chunk_in_worker, [(c, recordings) for c in chunks])
+        pool = WorkerPool(study, min(self.workers, len(indices)))
+        try:
+            yield from pool.run(study, None, indices, recordings)
+        finally:  # also on Ctrl-C or an error
+            pool.close()
 
 
 BACKENDS.register("local")(LocalBackend)
@@ -137,7 +108,9 @@ class _RayWorker:
 
 class RayBackend:
     """``ray.init(address=...)`` for an existing cluster, else a local instance of ``workers``
-    CPUs; one actor per CPU (as many as the cluster has, with an address)."""
+    CPUs; one actor per CPU (as many as the cluster has, with an address). A chunk whose actor
+    is lost is sent again one scenario at a time to fresh actors; a scenario whose actor is
+    lost twice is a failed row."""
 
     name = "ray"
 
@@ -153,36 +126,93 @@ class RayBackend:
     def run(self, study: Study, chunks: Sequence[list[int]],
             recordings: Path | None) -> Generator[ChunkResult, None, None]:
         import ray
-        from ray.util import ActorPool
 
         started = not ray.is_initialized()
         if started:
-            options: dict[str, Any] = {"include_dashboard": False, "logging_level": "ERROR",
-                                       "log_to_driver": False}
-            if self.address is None:
-                options["num_cpus"] = self.workers
-            ray.init(address=self.address, **options)
+            self._connect()
         actors: list[Any] = []
         try:
             if self.address is not None:
                 self.workers = max(1, int(ray.cluster_resources().get("CPU", self.workers)))
-            ref = ray.put(study)
-            actor: Any = ray.remote(num_cpus=1)(_RayWorker)
-            actors += [actor.remote(ref) for _ in range(min(self.workers, len(chunks)))]
-            pool = ActorPool(actors)
-            yield from pool.map_unordered(
-                lambda a, chunk: a.run.remote(chunk, recordings), list(chunks))
+            yield from _RayRun(study, ray.put(study), recordings, actors).run(
+                chunks, min(self.workers, len(chunks)))
         finally:
             for a in actors:
                 ray.kill(a)
             if started:
                 ray.shutdown()
 
+    def _connect(self) -> None:
+        """A local instance, or the cluster at ``address``: one line when it cannot be had
+        (a cluster with token authentication asks for ``RAY_AUTH_MODE=token`` and the
+        token)."""
+        import ray
+
+        options: dict[str, Any] = {"include_dashboard": False, "logging_level": "ERROR",
+                                   "log_to_driver": False}
+        if self.address is None:
+            options["num_cpus"] = self.workers
+        try:
+            with quiet_c_output(2):  # Ray's core logs each retry of a refused connection
+                ray.init(address=self.address, **options)
+        except (ConnectionError, RuntimeError, ValueError) as exc:
+            reason = " ".join(str(exc).split())[:200]
+            raise InputError(
+                f"cannot use the Ray cluster at {self.address or 'this machine'} ({reason}); "
+                "a cluster with token authentication needs RAY_AUTH_MODE=token and its token "
+                "in RAY_AUTH_TOKEN or RAY_AUTH_TOKEN_PATH (docs/studies.md)",
+                key="address") from None
+
     def hold(self, base: Study) -> None:
         """Nothing kept: each run starts its actors (a cluster's are shared)."""
 
     def close(self) -> None:
         pass
+
+
+class _RayRun:
+    """One study's chunks on actors; a lost actor's chunk is split and sent again."""
+
+    def __init__(self, study: Study, ref: Any, recordings: Path | None,
+                 actors: list[Any]) -> None:
+        import ray
+
+        self.study, self.ref, self.recordings, self.actors = study, ref, recordings, actors
+        self.actor: Any = ray.remote(num_cpus=1, max_restarts=0)(_RayWorker)
+
+    def run(self, chunks: Sequence[list[int]], width: int
+            ) -> Generator[ChunkResult, None, None]:
+        import ray
+        from ray.exceptions import RayActorError, WorkerCrashedError
+
+        todo = [(list(c), 0) for c in chunks]  # (indices, times their actor was lost)
+        running: dict[Any, tuple[Any, list[int], int]] = {}  # future: (actor, chunk, lost)
+        free = [self._new() for _ in range(width)]
+        while todo or running:
+            while todo and free:
+                actor = free.pop()
+                indices, lost = todo.pop(0)
+                running[actor.run.remote(indices, self.recordings)] = (actor, indices, lost)
+            done, _ = ray.wait(list(running), num_returns=1)
+            actor, indices, lost = running.pop(done[0])
+            try:
+                result: ChunkResult = ray.get(done[0])
+            except (RayActorError, WorkerCrashedError) as exc:
+                reason = f"Ray actor lost ({type(exc).__name__})"
+                log.warning("scenarios %s: %s; running them again", indices, reason)
+                free.append(self._new())
+                if lost == 0:  # again, a scenario each, so one that kills its actor is found
+                    todo[:0] = [([i], 1) for i in indices]
+                else:
+                    yield failed_scenario(self.study, indices[0], f"{reason} (twice)")
+                continue
+            free.append(actor)
+            yield result
+
+    def _new(self) -> Any:
+        actor = self.actor.remote(self.ref)
+        self.actors.append(actor)
+        return actor
 
 
 BACKENDS.register("ray")(RayBackend)

@@ -45,7 +45,11 @@ def write_plots(result: StudyResult, summary: Summary, folder: Path) -> list[Pat
     import matplotlib.pyplot as plt
 
     folder.mkdir(parents=True, exist_ok=True)
-    written = []
+    written: list[Path] = []
+    if result.interrupted or not any(row.get("status") == "ok" for row in result.rows):
+        # An interrupted study writes its rows at once (a signal gives a few seconds, and
+        # drawing takes them); one whose rows all failed has nothing to draw.
+        return written
     for name in PLOTS:
         entry = PLOTS.get(name)
         if not entry.applies(result):

@@ -67,6 +67,15 @@ def run_scenario(study: Study, index: int, *, recordings: Path | None = None,
     return ChunkResult(1, rows, failures)
 
 
+def failed_scenario(study: Study, index: int, reason: str) -> ChunkResult:
+    """Scenario ``index``'s rows, every variant failed for ``reason`` (its worker died)."""
+    scenario = study.scenario(index)
+    rows = [{"scenario": index, "seed": scenario.seed, "variant": variant.name,
+             **variant.columns, "status": "failed", "error": reason}
+            for variant in study.variants]
+    return ChunkResult(1, rows, [f"scenario {index}, seed {scenario.seed}: {reason}"])
+
+
 def run_chunk(study: Study, indices: Sequence[int], recordings: Path | None) -> ChunkResult:
     done = ChunkResult(0, [], [])
     for index in indices:
