@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from astralis_des.action_params import check_params
-from astralis_des.errors import InputError, suggest
+from astralis_des.errors import suggest
 from astralis_des.mission.spec import CommandEvent, MissionSpec
 from astralis_des.plugins import ACTIONS, SENSORS, STRATEGIES, actions_for
 from astralis_des.registry import UnknownEntry
@@ -15,6 +15,7 @@ from astralis_des.validation import check_unique_ids, validate
 from astralis_des.world.build import load_world
 from astralis_des.world.catalogue import Catalogue, default_catalogue, load_catalogue
 from astralis_des.world.model import World
+from astralis_des.world.placement import problem
 from astralis_des.yamlio import KeyPath, LocatedYaml, load_yaml
 
 
@@ -122,6 +123,7 @@ def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None
         raise doc.error(("target", "avatar", "tied_to_chair"), "only a sitting avatar is tied "
                         f"to a chair (activity: {avatar.activity})")
     kinds = {m.id: m.kind for m in spec.team}
+    points: dict[tuple[tuple[float, ...], str], KeyPath] = {}  # where a robot stands or goes
     for i, member in enumerate(spec.team):
         for name in member.sensor_set.plugins:
             if name not in SENSORS:
@@ -132,10 +134,7 @@ def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None
         if isinstance(member.start, str):
             room(member.start, ("team", i, "start"))
         else:
-            try:
-                world.router.place_of(member.start)
-            except InputError as exc:
-                raise doc.error(("team", i, "start"), exc.message) from None
+            points.setdefault((tuple(member.start), member.kind), ("team", i, "start"))
     for i, event in enumerate(spec.timeline):
         robot = getattr(event, "robot", None)
         if robot is not None and robot not in kinds:
@@ -155,6 +154,21 @@ def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None
                     check_params(event.action, {name: event.params[name]})
                 except ValueError as exc:
                     raise doc.error(("timeline", i, "params", name), str(exc)) from None
+            goal = _goal(event)
+            if goal is not None:
+                points.setdefault((goal, kinds[event.robot]), ("timeline", i, "params"))
+    for (point, who), where in points.items():  # each point and kind once, in file order
+        refused = problem(world, point, who)
+        if refused is not None:
+            raise doc.error(where, refused)
     if spec.timeline and max(e.at for e in spec.timeline) > spec.time_limit:
         late = max(range(len(spec.timeline)), key=lambda k: spec.timeline[k].at)
         raise doc.error(("timeline", late, "at"), "this event comes after time_limit")
+
+
+def _goal(event: CommandEvent) -> tuple[float, ...] | None:
+    """The point a ``move`` command names (params x, y and z), if it names one."""
+    if event.action != "move" or event.room is not None or not {"x", "y"} <= set(event.params):
+        return None
+    x, y, z = (event.params.get(k, 0.0) for k in ("x", "y", "z"))
+    return (float(x), float(y), float(z))

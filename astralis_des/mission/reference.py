@@ -21,11 +21,15 @@ EXAMPLE = "missions/urban_search.yaml"
 INTRO = """# Mission file reference
 
 Generated from the schema (`astralis schema --markdown -o docs/missions.md`; a test checks that
-it is up to date). A mission is a YAML file; `astralis validate FILE` checks one, and
-`astralis world rooms WORLD` lists the ids of rooms, segments and doors it can name. Keys are
-dotted paths: `team[]` is an item of the list `team` (`timeline[event=fault]` one of its
-events of that kind), `rooms.set{}` a value of the map `rooms.set`. The example column is the
-value in `{example}`, where it sets the key. Timeline events are told apart by `event`
+it is up to date). A mission is a YAML file (a regular file of at most 50 MB and 2,000,000
+values); `astralis validate FILE` checks one and its world (`docs/worlds.md`) as `astralis run`
+does: every start, and every point a `move` command of the timeline goes to, must be on the
+site and clear of walls, slabs and obstacles by the robot's body (the error names the nearest
+free point). `astralis world rooms WORLD` lists the ids of rooms, segments and doors a mission
+can name. Keys are dotted paths: `team[]` is an item of the list `team`
+(`timeline[event=fault]` one of its events of that kind), `rooms.set{}` a value of the map
+`rooms.set`. The example column is the value in `{example}`,
+where it sets the key. Timeline events are told apart by `event`
 (`fault`, `recover`, `room_change`, `command`, `cancel`); a command's `params` are the
 action's own (`astralis_des/action_params.py`).
 

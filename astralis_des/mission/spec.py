@@ -24,6 +24,7 @@ from astralis_des.mission.sensor_spec import (  # noqa: F401  (re-exported)
 from astralis_des.mission.types import (  # noqa: F401  (re-exported)
     MAX_SPEED,
     NAME_MAX,
+    FileName,
     Finite,
     Kind,
     NonNegativeFloat,
@@ -40,7 +41,8 @@ class MemberSpec(Strict):
 
     id: str = Field(pattern=r"^[A-Za-z][A-Za-z0-9_-]*$")
     kind: Kind
-    start: Vec3 | str = Field(description="[x, y, z] in metres, or a room id")
+    start: Vec3 | str = Field(description="[x, y, z] in metres (on the site, clear of solids "
+                              "by its body), or a room id")
     speed: PositiveFloat | None = Field(None, le=MAX_SPEED,
                                         description="m/s; default by kind")
     height: PositiveFloat | None = Field(
@@ -288,8 +290,8 @@ class OutputsSpec(Strict):
 
 
 class MissionSpec(Strict):
-    name: str = Field(pattern=r"^[A-Za-z0-9_.-]+$", max_length=NAME_MAX,
-                      description="also the output folder's name (out/NAME)")
+    name: FileName = Field(description="a plain file name (letters, digits and _ . -; not . "
+                           "or ..): also the output folder's name (out/NAME)")
     world: str = Field(description="world file, relative to the mission file")
     seed: int = Field(0, ge=0, description="every random draw derives from it")
     fidelity: Literal["kinematic", "physics"] = "kinematic"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
 # Every number is finite: no .inf time limits, no .nan positions; and no coordinate beyond
 # what any site holds (1,000 km), so arithmetic on it cannot overflow.
@@ -17,6 +17,18 @@ Kind = Literal["uav", "ugv", "human"]
 Unit = Annotated[float, Field(ge=0.0, le=1.0)]
 Sound = Literal["minimal", "moderate", "loud"]
 NAME_MAX = 200  # characters of a name that becomes a folder (file systems allow 255 bytes)
+
+
+def _plain(name: str) -> str:
+    if name in (".", ".."):  # out/.. is the working folder itself
+        raise ValueError(f"'{name}' is not a plain file name: it names the output folder "
+                         "(out/NAME); use letters, digits, _ . -")
+    return name
+
+
+# A name that becomes a folder: a plain file name, never a path (no /, not . or ..).
+FileName = Annotated[str, Field(pattern=r"^[A-Za-z0-9_.-]+$", max_length=NAME_MAX),
+                     AfterValidator(_plain)]
 
 
 class Strict(BaseModel):

@@ -28,7 +28,7 @@ if TYPE_CHECKING:
     from astralis_des.world.model import World
     from astralis_des.world.scene import Scene
 
-BODY_RADIUS = {"uav": 0.3, "ugv": 0.35, "human": 0.25}  # m, a disc around the body's centre
+BODY_RADIUS = {k: d.radius for k, d in KIND_DEFAULTS.items()}  # m, a disc round its centre
 # m more kept from furniture and people than from walls: a UAV cuts a corner of its path by
 # up to a quarter metre (measured), and it should not brush a person's head
 KEEP_OUT = {"uav": 0.2, "ugv": 0.0, "human": 0.0}

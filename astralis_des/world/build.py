@@ -11,11 +11,12 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+from astralis_des.errors import InputError
 from astralis_des.world.geometry import Box
 from astralis_des.world.imported import Imported, area_rooms, ground_slab, load_geometry
 from astralis_des.world.model import Building, Door, Room, Segment, Solid, Space, World
 from astralis_des.world.spec import BuildingSpec, WorldSpec
-from astralis_des.yamlio import LocatedYaml
+from astralis_des.yamlio import LocatedYaml, read_bytes
 
 LIFT_LENGTH = 2.4  # m along x: the vehicle lift's platform (the UGV turns on it)
 LANDING = 1.2  # m at least between the lift's shaft and the corridor, on every floor
@@ -69,9 +70,9 @@ def _road_box(start: tuple[float, float], end: tuple[float, float], width: float
 def load_world(path: Path) -> World:
     """Read, validate and build a world file. Built once for each content of the file: a
     file edited between two loads in one process (a notebook, a server) is read anew."""
-    try:
-        digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()
-    except OSError:
+    try:  # a FIFO or a device is refused, never read
+        digest = hashlib.sha256(read_bytes(path)).hexdigest()
+    except InputError:
         digest = ""  # load_yaml says what is wrong with the path
     return _built(Path(path), digest)
 

@@ -1,15 +1,22 @@
 """Routes through the world for the kinematic fidelity: a graph of rooms, doors, corridors,
-stairwells, entrances and outdoor corners, solved all-pairs once per world and agent kind."""
+stairwells, entrances and outdoor corners, one per agent kind, searched from a node when a
+route first leaves it (Dijkstra), its distances and predecessors kept for the next route.
+
+An all-pairs matrix (issue 38) cost 0.5 GB at 1,000 rooms and 9.5 GB a kind at 10,000; the
+rows of the nodes routes leave from are what is used, and each is the same row (scipy's
+Dijkstra from that node), so the routes are the same point for point.
+"""
 
 from __future__ import annotations
 
 import itertools
 import math
+from collections import OrderedDict
 from typing import Protocol
 
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import shortest_path
+from scipy.sparse.csgraph import dijkstra
 
 from astralis_des.errors import InputError
 from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
@@ -24,6 +31,8 @@ SNAP = 0.5  # m: a point this close to a room or corridor (in a wall, by a door)
 # Not outdoor blockers: walls and slabs are inside footprints, and an imported world's blocks
 # (thousands) are left to the navigator, which flies or walks round them on a grid.
 NOT_BLOCKERS = ("wall", "slab", BLOCK)
+CACHE_BYTES = 256_000_000  # of searched rows kept (12 B a node each): every row of a world of
+# 1,000 rooms, 600 of one of 10,000
 
 
 class Site(Protocol):
@@ -67,19 +76,42 @@ class Router:
                                        [s.box for s in world.spaces.values()])
         self._build()
         self.positions = np.array(self._pos, dtype=float)
-        self.dist: dict[str, FloatArray] = {}
-        self.pred: dict[str, np.ndarray] = {}
+        self._graphs = {kind: self._graph(kind) for kind in KINDS}
+        self._rows: OrderedDict[tuple[str, int], tuple[FloatArray, np.ndarray]] = OrderedDict()
+        self._row_limit = max(16, CACHE_BYTES // (12 * max(len(self.names), 1)))
+
+    def _graph(self, kind: str) -> csr_matrix:
+        rows: list[int] = []
+        cols: list[int] = []
+        vals: list[float] = []
+        for u, v, lengths in self._edges:
+            if kind in lengths:
+                rows += [u, v]
+                cols += [v, u]
+                vals += [lengths[kind]] * 2
         n = len(self.names)
-        for kind in KINDS:
-            rows, cols, vals = [], [], []
-            for u, v, lengths in self._edges:
-                if kind in lengths:
-                    rows += [u, v]
-                    cols += [v, u]
-                    vals += [lengths[kind]] * 2
-            graph = csr_matrix((vals, (rows, cols)), shape=(n, n))
-            self.dist[kind], self.pred[kind] = shortest_path(
-                graph, method="D", directed=False, return_predecessors=True)
+        return csr_matrix((vals, (rows, cols)), shape=(n, n))
+
+    def graph(self, kind: str) -> csr_matrix:
+        """The graph a ``kind`` moves on: node to node, each edge both ways (summed where an
+        edge was added twice), as routes are searched on it."""
+        return self._graphs[kind]
+
+    def _from(self, kind: str, sources: list[int]) -> tuple[FloatArray, np.ndarray]:
+        """``(len(sources), N)`` distances and predecessors from each source node, each row
+        searched once and kept (the least recently used dropped past ``CACHE_BYTES``)."""
+        missing = [u for u in dict.fromkeys(sources) if (kind, u) not in self._rows]
+        if missing:
+            dist, pred = dijkstra(self._graphs[kind], directed=False, indices=missing,
+                                  return_predecessors=True)
+            for k, u in enumerate(missing):
+                self._rows[(kind, u)] = (dist[k], pred[k])
+        for u in sources:
+            self._rows.move_to_end((kind, u))
+        found = [self._rows[(kind, u)] for u in sources]
+        while len(self._rows) > self._row_limit:
+            self._rows.popitem(last=False)
+        return np.array([d for d, _ in found]), np.array([p for _, p in found])
 
     # -- graph construction -------------------------------------------------------------
     def _node(self, name: str, pos: tuple[float, float, float]) -> int:
@@ -279,16 +311,12 @@ class Router:
             return None
         da = np.linalg.norm(self.positions[a] - p, axis=1)
         db = np.linalg.norm(self.positions[b] - q, axis=1)
-        total = da[:, None] + self.dist[kind][np.ix_(a, b)] + db[None, :]
+        dist, pred = self._from(kind, a)
+        total = da[:, None] + dist[:, b] + db[None, :]
         i, j = np.unravel_index(int(np.argmin(total)), total.shape)
         if not np.isfinite(total[i, j]):
             return None
-        nodes = self._walk(a[i], b[j], kind)
-        return np.vstack([p, self.positions[nodes], q])
-
-    def _walk(self, u: int, v: int, kind: str) -> list[int]:
-        pred = self.pred[kind][u]
-        nodes = [v]
-        while nodes[-1] != u:
-            nodes.append(int(pred[nodes[-1]]))
-        return nodes[::-1]
+        nodes = [b[j]]  # walked back from the goal's entry to the start's
+        while nodes[-1] != a[i]:
+            nodes.append(int(pred[i][nodes[-1]]))
+        return np.vstack([p, self.positions[nodes[::-1]], q])

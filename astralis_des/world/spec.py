@@ -2,21 +2,30 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
     NonNegativeInt,
-    PositiveFloat,
     PositiveInt,
+    ValidationInfo,
     field_validator,
     model_validator,
 )
 
-Vec2 = tuple[float, float]
-Vec3 = tuple[float, float, float]
+from astralis_des.kinds import KIND_DEFAULTS, LARGEST
+
+# Every number is finite (no .nan origin, no .inf size) and no coordinate or size is beyond
+# what any site holds (1,000 km, as in missions), so that arithmetic on them cannot overflow.
+MAX_EXTENT = 1_000_000.0  # m
+Coordinate = Annotated[float, Field(allow_inf_nan=False, ge=-MAX_EXTENT, le=MAX_EXTENT)]
+Length = Annotated[float, Field(gt=0, le=MAX_EXTENT, allow_inf_nan=False)]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Vec2 = tuple[Coordinate, Coordinate]
+Vec3 = tuple[Coordinate, Coordinate, Coordinate]
+Size3 = tuple[Length, Length, Length]
 Kind = Literal["uav", "ugv", "human"]
 KINDS: tuple[Kind, ...] = ("uav", "ugv", "human")
 
@@ -25,7 +34,12 @@ class Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
-MAX_ROOMS = 10_000  # rooms of a world: about 0.5 s to build; 200,000 took 42 s
+MAX_ROOMS = 10_000  # rooms of a world: loaded and routed in 0.6 s and 0.14 GB (bench_world)
+ROBOT = KIND_DEFAULTS[LARGEST].length  # m: a room or a corridor must hold the longest body
+
+
+def fits_a_robot(inside: tuple[float, ...]) -> bool:
+    return min(inside) >= ROBOT
 
 
 class SegmentSpec(Strict):
@@ -37,19 +51,38 @@ class BuildingSpec(Strict):
     id: str = Field(pattern=r"^[A-Za-z][A-Za-z0-9]*$", description="letter(s) used in room ids")
     origin: Vec2 = Field(description="south-west corner of the footprint, metres")
     floors: PositiveInt
-    floor_height: PositiveFloat = 3.5
-    wall_thickness: PositiveFloat = 0.2
-    room_size: tuple[PositiveFloat, PositiveFloat] = Field(
-        (4.0, 7.0), description="room width along the corridor and depth away from it")
-    corridor_width: PositiveFloat = 2.5
-    stairwell_width: PositiveFloat = 4.0
-    lobby_length: PositiveFloat = 4.0
-    door_width: PositiveFloat = 1.0
-    door_height: PositiveFloat = 2.1
+    floor_height: Length = 3.5
+    wall_thickness: Length = 0.2
+    room_size: tuple[Length, Length] = Field(
+        (4.0, 7.0), validate_default=True, description="room width along the corridor and "
+        "depth away from it, walls included: inside them, each side at least as long as the "
+        "longest robot")
+    corridor_width: Length = Field(2.5, validate_default=True,
+                                   description="walls included, like room_size")
+    stairwell_width: Length = 4.0
+    lobby_length: Length = 4.0
+    door_width: Length = 1.0
+    door_height: Length = 2.1
     stairs_passable_by: list[Kind] = Field(
         default_factory=lambda: list(KINDS),
         description="who can change floors (stairs with a vehicle ramp by default)")
     segments: list[SegmentSpec] = Field(min_length=1)
+
+    @field_validator("room_size", "corridor_width")
+    @classmethod
+    def _holds_a_robot(cls, size: tuple[float, float] | float,
+                       info: ValidationInfo) -> tuple[float, float] | float:
+        """Inside its walls, a room (or the corridor) holds the longest robot at any heading:
+        a room 1e-9 m wide gave a search nothing to cover (NaN in the summary)."""
+        t = info.data.get("wall_thickness")
+        sides = size if isinstance(size, tuple) else (size,)
+        if t is None or fits_a_robot(tuple(s - t for s in sides)):
+            return size
+        what = (f"rooms of {sides[0]:g} x {sides[1]:g} m are "
+                f"{max(sides[0] - t, 0):.2f} x {max(sides[1] - t, 0):.2f} m" if len(sides) == 2
+                else f"a corridor {sides[0]:g} m wide is {max(sides[0] - t, 0):.2f} m")
+        raise ValueError(f"{what} inside their {t:g} m walls: smaller than a robot (a "
+                         f"{LARGEST} is {ROBOT:g} m long); make each at least {ROBOT + t:g} m")
 
     @model_validator(mode="after")
     def _not_too_big(self) -> BuildingSpec:
@@ -71,7 +104,7 @@ class BuildingSpec(Strict):
 class ObstacleSpec(Strict):
     kind: str = Field(description="what it is (tree, vehicle, lamp_post, ...), shown in replays")
     center: Vec2
-    size: Vec3 = Field(description="box extent x, y, z in metres")
+    size: Size3 = Field(description="box extent x, y, z in metres")
 
 
 class RoadSpec(Strict):
@@ -79,20 +112,20 @@ class RoadSpec(Strict):
 
     start: Vec2
     end: Vec2
-    width: PositiveFloat = 7.0
+    width: Length = 7.0
 
 
 class GeoOrigin(Strict):
     """Where the site's (0, 0, 0) lies on the Earth (WGS 84): an imported scan's, from its
     coordinate system."""
 
-    latitude: float = Field(ge=-90, le=90, description="degrees north")
-    longitude: float = Field(ge=-180, le=180, description="degrees east")
-    altitude: float = Field(0.0, ge=-500, le=9000, description="m, of the ground")
+    latitude: Finite = Field(ge=-90, le=90, description="degrees north")
+    longitude: Finite = Field(ge=-180, le=180, description="degrees east")
+    altitude: Finite = Field(0.0, ge=-500, le=9000, description="m, of the ground")
 
 
 class SiteSpec(Strict):
-    size: tuple[PositiveFloat, PositiveFloat] = Field(description="outdoor area, metres")
+    size: tuple[Length, Length] = Field(description="outdoor area, metres")
     origin: GeoOrigin | None = Field(None, description="where (0, 0, 0) lies on the Earth; "
                                      "the GNSS's origin unless the mission gives its own site")
 
@@ -114,6 +147,9 @@ class AreaSpec(Strict):
         lo, hi = self.box
         if not all(a < b for a, b in zip(lo, hi, strict=True)):
             raise ValueError(f"box: each coordinate of {list(lo)} must be below {list(hi)}")
+        if not fits_a_robot((hi[0] - lo[0], hi[1] - lo[1])):
+            raise ValueError(f"box: an area of {hi[0] - lo[0]:g} x {hi[1] - lo[1]:g} m is "
+                             f"smaller than a robot (a {LARGEST} is {ROBOT:g} m long)")
         return self
 
 
@@ -134,19 +170,19 @@ class SourceSpec(Strict):
     kept: NonNegativeInt | None = Field(None, description="points kept, when the cloud was "
                                         "thinned evenly to fit (--max-points)")
     units: str = Field(description="the file's unit and where it was found")
-    scale: PositiveFloat = Field(description="metres per unit of the file")
+    scale: Length = Field(description="metres per unit of the file")
     up: Literal["y", "z"] = "z"
-    offset: Vec3 = Field(description="the file's coordinates (its units and axes) of this "
-                         "world's origin")
+    offset: tuple[Finite, Finite, Finite] = Field(
+        description="the file's coordinates (its units and axes) of this world's origin")
     ground: str | None = Field(None, description="how the ground was found (a cloud)")
     ground_share: float | None = Field(None, ge=0, le=1)
-    relief: float | None = Field(None, ge=0, description="m of ground relief flattened")
+    relief: Finite | None = Field(None, ge=0, description="m of ground relief flattened")
 
 
 class GeometrySpec(Strict):
     """An imported world's geometry, in files beside the world file."""
 
-    voxel: PositiveFloat = Field(0.2, description="m: the blocks' voxel and the planner's map")
+    voxel: Length = Field(0.2, description="m: the blocks' voxel and the planner's map")
     blocks: str | None = Field(None, description=".npz of merged voxel boxes: what blocks "
                                "sight and routes, and (collision: boxes) collides")
     mesh: str | None = Field(None, description=".obj of the imported mesh, in world "
@@ -154,7 +190,7 @@ class GeometrySpec(Strict):
     collision: Literal["boxes", "concave", "convex"] = "boxes"
     parts: str | None = Field(None, description=".obj of convex parts (collision: convex)")
     cloud: str | None = Field(None, description=".npz of a downsampled cloud for the replay")
-    floors: list[float] = Field(default_factory=list, description="floor heights found, m")
+    floors: list[Coordinate] = Field(default_factory=list, description="floor heights found, m")
 
     @model_validator(mode="after")
     def _files_for_collision(self) -> GeometrySpec:
