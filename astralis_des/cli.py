@@ -7,14 +7,26 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import importlib
 import json
+import logging
 import os
+import signal
 import sys
+import threading
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from astralis_des.exits import EXIT_BAD_INPUT, EXIT_INTERRUPTED, interrupt_on_termination
+from astralis_des.exits import (
+    EXIT_BAD_INPUT,
+    EXIT_INTERRUPTED,
+    EXIT_OUTPUT,
+    RECEIVED,
+    interrupt_on_termination,
+    interrupts_never_lost,
+)
 
 if TYPE_CHECKING:
     from astralis_des.simulation.result import RunResult
@@ -35,6 +47,7 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="astralis", description="Discrete-event missions for UAV/UGV/human search teams.")
     parser.add_argument("--version", action="store_true", help="print the version and exit")
+    parser.set_defaults(quiet=False)  # the commands that print progress take --quiet
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     run = sub.add_parser("run", help="run a mission file and write its outputs")
     run.add_argument("mission", help="mission YAML file")
@@ -128,6 +141,31 @@ def _positive(text: str) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """The command line. From its first line to its last write, Ctrl-C, SIGTERM and SIGHUP
+    end it with exit 130 and at most one line (a run keeps what it recorded)."""
+    before = {sig: signal.getsignal(sig) for sig in HANDLED}
+    RECEIVED.clear()
+    try:
+        interrupt_on_termination(ctrl_c=True)  # first: the heavy imports come later
+        with interrupts_never_lost():
+            return _main(argv)
+    except BaseException as exc:  # in the imports, a validation, before the outputs open
+        if not isinstance(exc, KeyboardInterrupt) and not (RECEIVED and
+                                                         isinstance(exc, Exception)):
+            raise  # a bug, not a signal (an import a signal cut short can fail otherwise)
+        _ignore_signals()  # one line, even if the signal comes again
+        print("interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        if argv is None:  # the process is ours and its work done: a late signal ends it
+            _exit_on_signals()  # at once, without a traceback from an exit handler
+        else:  # a caller's (tests): its handlers back
+            for sig, handler in before.items():
+                signal.signal(sig, handler)
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    os.environ.setdefault("RUST_LOG", "off")  # Rerun's own log lines: the errors are ours
     args = _parser().parse_args(argv)
     if args.version:
         from astralis_des.version import __version__
@@ -137,17 +175,100 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         _parser().print_help()
         return 0
-    interrupt_on_termination()
     from astralis_des.errors import InputError
+    from astralis_des.outdir import MACHINE_ERRNOS, OutputError
 
     try:
-        return COMMANDS[args.command](args)
+        with _quiet(args.quiet, own_process=argv is None):
+            if args.command in SIMULATING:
+                _import_silently("pybullet")  # it prints its build time on stderr as it loads
+            return COMMANDS[args.command](args)
     except BrokenPipeError:  # the reader went away (| head): no traceback, nothing more
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except InputError as exc:
         print(f"error: {exc.one_line()}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except OutputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_OUTPUT
+    except OSError as exc:  # a full disk or an I/O error in a write not staged
+        if exc.errno not in MACHINE_ERRNOS:
+            raise
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return EXIT_OUTPUT
+
+
+@contextlib.contextmanager
+def _quiet(quiet: bool, *, own_process: bool) -> Iterator[None]:
+    """``--quiet``: nothing on stderr but errors: no library warnings (``logging`` below
+    ERROR), and in a process of its own no Python warnings either (a caller in the same
+    process keeps its own warning filters)."""
+    if not quiet:
+        yield
+        return
+    level = logging.root.manager.disable
+    logging.disable(logging.WARNING)
+    try:
+        with warnings.catch_warnings():
+            if own_process:
+                warnings.simplefilter("ignore")
+            yield
+    finally:
+        logging.disable(level)
+
+
+def _import_silently(module: str) -> None:
+    """Import ``module`` with the process's stderr (file descriptor 2) pointed at /dev/null
+    meanwhile: PyBullet prints its build time there as it loads."""
+    if module in sys.modules:
+        return
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError):  # no stderr to silence
+        return
+    try:
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 2)
+        os.close(null)
+        with contextlib.suppress(ImportError):
+            importlib.import_module(module)
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
+SIMULATING = frozenset({"run", "study", "tune", "serve", "chat", "export"})  # may load PyBullet
+HANDLED = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP")
+                if hasattr(signal, n))
+
+
+def _ignore_signals() -> None:
+    if threading.current_thread() is threading.main_thread():
+        for sig in HANDLED:
+            if signal.getsignal(sig) is not signal.SIG_IGN:
+                signal.signal(sig, signal.SIG_IGN)
+
+
+def _exit_on_signals() -> None:
+    """From here on a signal ends the process at once, with exit 130 and nothing printed."""
+    def end(signum: int, frame: object) -> None:
+        _exit_now(EXIT_INTERRUPTED)
+
+    if threading.current_thread() is threading.main_thread():
+        for sig in HANDLED:
+            if signal.getsignal(sig) is not signal.SIG_IGN:
+                signal.signal(sig, end)
+
+
+def _exit_now(code: int) -> None:
+    """End the process with ``code`` once what it printed is out (the outputs are in place)."""
+    with contextlib.suppress(Exception):
+        sys.stdout.flush()
+        sys.stderr.flush()
+    os._exit(code)
 
 
 @command("replay")
@@ -247,6 +368,7 @@ def _world_import(args: argparse.Namespace) -> int:
     from rich.console import Console
 
     from astralis_des.importers import ImportOptions, import_world
+    from astralis_des.outdir import holding
 
     options = ImportOptions(
         units=args.units, crs=args.crs, voxel=args.voxel, ground=args.ground, fill=args.fill,
@@ -257,8 +379,8 @@ def _world_import(args: argparse.Namespace) -> int:
     command_line = " ".join(["astralis world import", *sys.argv[3:]]) if \
         sys.argv[1:3] == ["world", "import"] else None
     console = Console(highlight=False, stderr=True)
-    try:
-        with _import_progress(console) as progress:
+    try:  # the output locked (and found writable) before the import
+        with holding(args.output), _import_progress(console) as progress:
             report = import_world(args.file, args.output, options, command=command_line,
                                   progress=progress)
     except KeyboardInterrupt:
@@ -347,7 +469,11 @@ def _schema(args: argparse.Namespace) -> int:
 
         text = reference(Path(EXAMPLE))
     if args.output:
-        Path(args.output).write_text(text, encoding="utf-8")
+        from astralis_des.outdir import Staging
+
+        target = Path(args.output)
+        with Staging(target, file=True) as folder:
+            (folder / target.name).write_text(text, encoding="utf-8")
     else:
         sys.stdout.write(text)
     return 0
@@ -358,6 +484,7 @@ def _run(args: argparse.Namespace) -> int:
     from rich.console import Console
 
     from astralis_des.mission.overrides import mission_from_args
+    from astralis_des.outdir import holding
     from astralis_des.simulation import Simulation
 
     mission, out = mission_from_args(args)
@@ -366,13 +493,19 @@ def _run(args: argparse.Namespace) -> int:
 
         require()
     console = Console(stderr=True, quiet=args.quiet)
+    made: list[Simulation] = []
+
+    def run(progress: Any) -> RunResult:
+        made.append(Simulation(mission, out_dir=out, progress=progress, view=args.view))
+        return made[0].run()
+
     try:
-        result = _with_progress(console, mission.spec.time_limit,
-                                lambda progress: Simulation(mission, out_dir=out,
-                                                            progress=progress,
-                                                            view=args.view).run())
+        with holding(out):  # a second writer is refused before the world is built
+            result = _with_progress(console, mission.spec.time_limit, run)
     except KeyboardInterrupt:
-        console.print(f"[yellow]interrupted[/]; what was recorded is in {out}/")
+        recorded = bool(made) and made[0].started
+        console.print("[yellow]interrupted[/]; " + (f"what was recorded is in {out}/"
+                                                     if recorded else "nothing written"))
         return EXIT_INTERRUPTED
     if not args.quiet:
         _print_summary(Console(), result, out)
@@ -441,4 +574,7 @@ def _print_rooms(console: Any, result: RunResult) -> None:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    code = main()
+    if RECEIVED:  # interrupted: under python -m, an interrupt that went through an exec() (a
+        _exit_now(code)  # dataclass being made) makes CPython end by killing itself with
+    sys.exit(code)  # SIGINT (its "unhandled KeyboardInterrupt" flag), not with this code

@@ -17,6 +17,7 @@ import pytest
 
 from astralis_des import RunResult, Simulation, load_mission
 from astralis_des.cli import main
+from astralis_des.outdir import staging_path
 from astralis_des.sinks import recording as recording_module
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -161,7 +162,8 @@ def test_view_streams_to_a_viewer_as_the_run_goes(tmp_path: Path,
                         lambda self, path: connected.append(path))
     assert main(["run", str(ROOT / "missions" / "fig7.yaml"), "--out", str(tmp_path),
                  "--quiet", "--view"]) == 0
-    assert connected == [tmp_path / "recording.rrd"]
+    assert connected == [staging_path(tmp_path) / "recording.rrd"]  # written there, then put
+    # in place
     out = subprocess.run([RERUN, "rrd", "print", str(tmp_path / "recording.rrd")],
                          capture_output=True, text=True, check=True).stdout
     pieces = [int(m[1]) for m in map(CHUNK.match, out.splitlines())
@@ -179,16 +181,17 @@ def test_ctrl_c_leaves_a_recording_and_an_event_log_that_load(tmp_path: Path) ->
                              str(ROOT / "missions" / "urban_search.yaml"), "--fidelity",
                              "physics", "--out", str(out), "--quiet"], env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    events = out / "events.jsonl"
+    growing = staging_path(out) / "events.jsonl"  # the run's folder until it ends
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and proc.poll() is None:
-        if events.exists() and events.read_text(encoding="utf-8").count("task_started") >= 3:
+        if growing.exists() and growing.read_text(encoding="utf-8").count("task_started") >= 3:
             break
         time.sleep(0.05)
     assert proc.poll() is None, "the run ended before it could be interrupted"
     proc.send_signal(signal.SIGINT)
     assert proc.wait(timeout=60) == 130
     verify(out / "recording.rrd")
+    events = out / "events.jsonl"
     records = [json.loads(line) for line in events.read_text(encoding="utf-8").splitlines()]
     assert records[0]["kind"] == "mission_start"
     assert records[-1] == {**records[-1], "kind": "mission_end", "outcome": "interrupted"}

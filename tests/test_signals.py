@@ -18,6 +18,8 @@ import pytest
 from test_api_safety import free_port
 from test_recording import verify
 
+from astralis_des.outdir import staging_path
+
 ROOT = Path(__file__).resolve().parents[1]
 MISSION = ROOT / "missions" / "urban_search.yaml"
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
@@ -29,7 +31,9 @@ def astralis(*args: str) -> subprocess.Popen[str]:
 
 
 def wait_for(events: Path, proc: subprocess.Popen[str], started: int) -> None:
-    """Until the event log shows ``started`` tasks started (the run is well under way)."""
+    """Until the event log shows ``started`` tasks started (the run is well under way); it
+    grows in the staging folder beside the output folder until the run ends."""
+    events = staging_path(events.parent) / events.name
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and proc.poll() is None:
         if events.exists() and events.read_text(encoding="utf-8").count("task_started") >= started:
@@ -74,7 +78,7 @@ def test_a_kinematic_run_terminated_at_once_keeps_a_consistent_folder(tmp_path: 
     proc = astralis("run", str(MISSION), "--out", str(out), "--quiet")
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and proc.poll() is None and \
-            not (out / "events.jsonl").exists():
+            not (staging_path(out) / "events.jsonl").exists():
         time.sleep(0.005)
     proc.send_signal(signal.SIGTERM)
     code = proc.wait(timeout=60)

@@ -4,6 +4,12 @@ thousand, on a few processes; prints what became of them and keeps every failing
     python tools/fuzz.py                                   # 100,000 missions and requests
     python tools/fuzz.py --missions 2000 --requests 2000 --studies 50 --workers 2
 
+The missions' worlds include bad values (NaN, infinite, negative or tiny sizes and origins, rooms
+smaller than a robot, buildings off the site) and their starts and move commands points inside
+solids or off the site (``tests/fuzzing/strategies.py``); a quarter of the cases write to an
+output path other than ``out`` (nested, a symbolic link, accents, or one that cannot be
+written: under a file, a file, a name too long, ``/proc``: ``tests/fuzzing/cases.py``).
+
 Each case runs as ``tests/test_fuzz.py`` runs it (``tests/fuzzing/``), but a failure is counted
 and saved under ``--out`` (``failures/KIND-N/``, the files to re-run) instead of stopping the
 run. Exit status 1 if any case failed.

@@ -1,16 +1,15 @@
 """Writing an imported world: the world file and the files beside it, all or nothing.
 
-Everything is written into a temporary folder next to the target, the world file is loaded
-back from there as a mission would load it, and only then are the files renamed into place,
-the world file last. An error or an interruption leaves nothing half-written.
+Everything is written into a staging folder next to the target
+(:class:`~astralis_des.outdir.Staging`: locked against a second writer), the world file is
+loaded back from there as a mission would load it, and only then are the files renamed into
+place, the world file last. An error or an interruption leaves nothing half-written.
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
-import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -18,29 +17,23 @@ import yaml
 
 from astralis_des.importers.mesh import decimals_for
 from astralis_des.importers.options import Built
+from astralis_des.outdir import Staging
 
 MAX_INDEX = np.iinfo(np.uint16).max
 
 
 def write_world(built: Built, source: Path, out: Path, name: str, command: str) -> list[Path]:
     """Write ``out`` (a ``.yaml`` world) and its sidecars; return the paths written."""
-    out.parent.mkdir(parents=True, exist_ok=True)
     stem = out.name.rsplit(".", 1)[0]
-    folder = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
+    with Staging(out, file=True) as folder:
         geometry = _sidecars(built, folder, stem)
         doc = _document(built, source, out, name, geometry)
         text = _header(built, source, command) + _dump(doc) + areas_text(built)
         (folder / out.name).write_text(text, encoding="utf-8")
         _check(folder / out.name)
-        written = []
-        for file in [*(geometry[k] for k in ("blocks", "mesh", "parts", "cloud")
-                       if k in geometry), out.name]:
-            os.replace(folder / str(file), out.parent / str(file))
-            written.append(out.parent / str(file))
-        return written
-    finally:
-        shutil.rmtree(folder, ignore_errors=True)
+    return [out.parent / str(file) for file in [
+        *(geometry[k] for k in ("blocks", "mesh", "parts", "cloud") if k in geometry),
+        out.name]]
 
 
 def _check(path: Path) -> None:

@@ -335,6 +335,11 @@ class Simulation:
         return self._end.triggered
 
     @property
+    def started(self) -> bool:
+        """Whether the outputs are open and the mission under way (``start``)."""
+        return self._end is not None
+
+    @property
     def ended(self) -> bool:
         """Whether the mission has ended (found, searched out, team lost or out of time)."""
         return self._end is not None and self._end.triggered
@@ -345,7 +350,9 @@ class Simulation:
         return self._sinks.seconds if self._sinks is not None else 0.0
 
     def finish(self) -> RunResult:
-        """End the run where it is: halt the robots, close the outputs, return the result."""
+        """End the run where it is: halt the robots, close the outputs, return the result.
+        A signal meanwhile does not cut the outputs short: it ends the landings of the wind-
+        down at once, and is raised (``KeyboardInterrupt``) once the outputs are in place."""
         if self.found.triggered:
             outcome = "found"
         elif self._timeline is not None and self._timeline.triggered:
@@ -354,8 +361,19 @@ class Simulation:
             outcome = "time_limit"                                  # as soon as it exists
         else:
             outcome = "interrupted"
+        cut: KeyboardInterrupt | None = None
         if outcome in WIND_DOWN:
-            self._wind_down()
+            try:
+                self._wind_down()
+            except KeyboardInterrupt as signal:
+                cut = signal
+        with deferred_interrupts():
+            result = self._close(outcome)
+        if cut is not None:
+            raise cut
+        return result
+
+    def _close(self, outcome: str) -> RunResult:
         for robot in self.robots.values():
             self.cosim.halt(robot)
             if robot.id in self._started:  # still at work when the mission ended

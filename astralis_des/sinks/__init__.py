@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
-import json
+import contextlib
 import os
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 from astralis_des.kernel.events import Record
+from astralis_des.outdir import Staging, checked, result_files, write_failure, write_file
+from astralis_des.outdir import dumps as strict_dumps
 from astralis_des.simulation.outputs import OUTPUTS
 
 if TYPE_CHECKING:
@@ -16,38 +18,76 @@ if TYPE_CHECKING:
     from astralis_des.simulation.result import RunResult
 
 
-OUTPUT_FILES = ("events.jsonl", "summary.json", "recording.rrd", "run.mcap")
+OUTPUT_FILES = result_files("events.jsonl", "summary.json", "recording.rrd", "run.mcap",
+                            key="summary.json")
 
 
 class Output(Protocol):
     def on_event(self, record: Record) -> None: ...
     def close(self, result: RunResult) -> None: ...
+    def discard(self) -> None: ...  # the run's outputs are abandoned: let go of the file
 
 
 class Outputs:
-    """The open outputs of one run; each sees every event, then the result. ``seconds`` is
-    the wall time they took, opening included, for benchmarks to report their share."""
+    """The open outputs of one run; each sees every event, then the result. They are written
+    into a staging folder (:class:`~astralis_des.outdir.Staging`) put in place when the run
+    closes, also when it was interrupted; a failed write removes it and raises, one line
+    (:func:`~astralis_des.outdir.write_failure`). ``seconds`` is the wall time they took,
+    opening included, for benchmarks to report their share."""
 
-    def __init__(self, outputs: list[Output], seconds: float = 0.0) -> None:
+    def __init__(self, outputs: list[Output], seconds: float = 0.0,
+                 stage: Staging | None = None) -> None:
         self.outputs = outputs
         self.seconds = seconds
+        self.stage = stage
+        self.failed: Exception | None = None  # the first failed write: nothing more is written
 
     def on_event(self, record: Record) -> None:
+        if self.failed is not None:
+            return
         t0 = time.perf_counter()
-        for out in self.outputs:
-            out.on_event(record)
-        self.seconds += time.perf_counter() - t0
+        try:
+            for out in self.outputs:
+                out.on_event(record)
+        except OSError as exc:  # a full disk: the run stops here, and its outputs go
+            self.failed = self._failure(exc)
+            self._abandon()
+            raise self.failed from exc
+        finally:
+            self.seconds += time.perf_counter() - t0
 
     def close(self, result: RunResult) -> None:
         t0 = time.perf_counter()
-        for out in self.outputs:
-            out.close(result)
+        try:
+            if self.failed is not None:
+                raise self.failed
+            for out in self.outputs:
+                out.close(result)
+        except OSError as exc:
+            self._abandon()
+            raise self._failure(exc) from exc
+        except BaseException:
+            self._abandon()
+            raise
+        if self.stage is not None:
+            self.stage.commit()
         self.seconds += time.perf_counter() - t0
+
+    def _failure(self, exc: OSError) -> Exception:
+        where = self.stage.target if self.stage is not None else Path(exc.filename or ".")
+        return write_failure(where, exc)
+
+    def _abandon(self) -> None:
+        for out in self.outputs:
+            out.discard()
+        if self.stage is not None:
+            self.stage.abandon()
 
 
 class JsonlWriter:
     """``events.jsonl``: one event a line, written as it happens (line-buffered), so an
-    interrupted or killed run keeps every complete line and a reader can follow it."""
+    interrupted run keeps every complete line and a reader can follow it (in the staging
+    folder, :func:`~astralis_des.outdir.staging_path`, until the run ends)."""
 
     def __init__(self, path: Path) -> None:
         self._file = path.open("w", encoding="utf-8", buffering=1)
@@ -56,7 +96,13 @@ class JsonlWriter:
         self._file.write(dumps(record) + "\n")
 
     def close(self, result: RunResult) -> None:
+        self._file.flush()
+        os.fsync(self._file.fileno())
         self._file.close()
+
+    def discard(self) -> None:
+        with contextlib.suppress(OSError):  # its bytes could not be written: no matter now
+            self._file.close()
 
 
 class SummaryWriter:
@@ -67,42 +113,47 @@ class SummaryWriter:
         pass
 
     def close(self, result: RunResult) -> None:
-        write_atomic(self.path, json.dumps(result.summary(), indent=2) + "\n")
+        write_file(self.path, strict_dumps(result.summary(), indent=2) + "\n")
+
+    def discard(self) -> None:
+        pass
 
 
 def dumps(record: Any) -> str:
-    return json.dumps(record, separators=(",", ":"), ensure_ascii=False)
-
-
-def write_atomic(path: Path, text: str) -> None:
-    """Write through a temporary file and rename, so no reader sees half a file."""
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
+    return strict_dumps(record, separators=(",", ":"), ensure_ascii=False)
 
 
 @OUTPUTS.register("files")
 def open_sinks(sim: Simulation, out_dir: Path | None) -> Outputs:
-    """Open what the mission's ``outputs`` asks for under ``out_dir`` (nothing without one)."""
+    """Open what the mission's ``outputs`` asks for, staged for ``out_dir`` (nothing without
+    one); an earlier run's files there are replaced only when this run closes."""
     t0 = time.perf_counter()
     outputs: list[Output] = []
+    stage = None
     if out_dir is not None:
         cfg = sim.mission.spec.outputs
-        out_dir.mkdir(parents=True, exist_ok=True)
-        for name in OUTPUT_FILES:  # an earlier run's files never sit beside this run's
-            (out_dir / name).unlink(missing_ok=True)
-        if cfg.events:
-            outputs.append(JsonlWriter(out_dir / "events.jsonl"))
-        if cfg.summary:
-            outputs.append(SummaryWriter(out_dir / "summary.json"))
-        if cfg.recording:
-            from astralis_des.sinks.recording import RerunRecorder
+        stage = Staging(out_dir, owned=OUTPUT_FILES, last="summary.json",
+                        keep_interrupted=True)
+        folder = stage.open()
+        try:
+            with checked(out_dir):
+                if cfg.events:
+                    outputs.append(JsonlWriter(folder / "events.jsonl"))
+                if cfg.summary:
+                    outputs.append(SummaryWriter(folder / "summary.json"))
+                if cfg.recording:
+                    from astralis_des.sinks.recording import RerunRecorder
 
-            outputs.append(RerunRecorder(sim, out_dir / "recording.rrd", view=sim.view))
-        if cfg.mcap:
-            from astralis_des.sinks.mcap_out import McapWriter
+                    outputs.append(RerunRecorder(sim, folder / "recording.rrd", view=sim.view))
+                if cfg.mcap:
+                    from astralis_des.sinks.mcap_out import McapWriter
 
-            outputs.append(McapWriter(sim, out_dir / "run.mcap"))
-    sinks = Outputs(outputs, time.perf_counter() - t0)
+                    outputs.append(McapWriter(sim, folder / "run.mcap"))
+        except BaseException:
+            for out in outputs:
+                out.discard()
+            stage.abandon()
+            raise
+    sinks = Outputs(outputs, time.perf_counter() - t0, stage)
     sim.log.sinks.append(sinks.on_event)
     return sinks

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from astralis_des.errors import InputError
 from astralis_des.mission.loader import load_mission
+from astralis_des.outdir import Staging, sync
 from astralis_des.simulation import Simulation
 from astralis_des.sinks.mcap_out import require
 
@@ -53,5 +54,7 @@ def export_mcap(run_dir: str | Path, mission_file: str | Path | None = None) -> 
                              f"line {differ + 1}): was the mission or the world changed?",
                              file=events, line=differ + 1)
         target = folder / "run.mcap"
-        shutil.move(str(Path(tmp) / "run.mcap"), target)
+        with Staging(target, file=True) as staged:  # in place whole, or not at all
+            shutil.copyfile(Path(tmp) / "run.mcap", staged / target.name)
+            sync(staged / target.name)
     return target

@@ -14,7 +14,7 @@ it is interrupted), in time order.
 
 from __future__ import annotations
 
-import json
+import os
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -23,6 +23,7 @@ import numpy as np
 
 from astralis_des.errors import InputError
 from astralis_des.kernel.events import Record
+from astralis_des.outdir import dumps
 from astralis_des.sinks import ros_messages as ros
 from astralis_des.world.geometry import Box
 from astralis_des.world.model import BLOCK
@@ -78,14 +79,13 @@ class McapWriter:
 
         ty = ros.typestore()
         messages = sorted(self._messages(ty), key=lambda m: m[0])  # stable: ties keep order
-        tmp = self.path.with_name(self.path.name + ".tmp")
-        with tmp.open("wb") as f:
+        with self.path.open("wb") as f:
             writer = Writer(f, compression=CompressionType.LZ4)  # ZSTD: 25% smaller, slower
             writer.start(profile="ros2", library="astralis-des")
             channels: dict[str, int] = {}
             json_schema = writer.register_schema(
                 name="astralis_des/Event", encoding="jsonschema",
-                data=json.dumps(EVENT_SCHEMA).encode())
+                data=dumps(EVENT_SCHEMA).encode())
             for seq, (t, topic, typename, msg) in enumerate(messages):
                 if topic not in channels:
                     if typename == "json":
@@ -97,13 +97,17 @@ class McapWriter:
                                                         data=text.encode())
                         channels[topic] = writer.register_channel(
                             topic, message_encoding="cdr", schema_id=schema)
-                data = (json.dumps(msg, separators=(",", ":")).encode() if typename == "json"
+                data = (dumps(msg, separators=(",", ":")).encode() if typename == "json"
                         else bytes(ty.store.serialize_cdr(msg, typename)))
                 ns = round(t * 1e9)
                 writer.add_message(channels[topic], log_time=ns, publish_time=ns, data=data,
                                    sequence=seq)
             writer.finish()
-        tmp.replace(self.path)
+            f.flush()
+            os.fsync(f.fileno())  # a full disk fails here, not as a short file later
+
+    def discard(self) -> None:
+        pass
 
     def _messages(self, ty: ros.Types) -> Iterator[ros.Stamped]:
         sim = self.sim

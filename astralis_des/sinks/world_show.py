@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import os
+import contextlib
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -11,6 +11,8 @@ from typing import Any
 
 from astralis_des.errors import InputError
 from astralis_des.mission.draws import RoomState
+from astralis_des.outdir import Staging
+from astralis_des.sinks.rrd_check import check_recording
 from astralis_des.world.build import load_world
 from astralis_des.world.catalogue import default_catalogue, load_catalogue
 from astralis_des.world.model import World
@@ -43,16 +45,16 @@ def show_world(world_file: str | Path, messiness: Sequence[float], out: str | Pa
     scene = Scene(world, values, seed, cat)
     placed = scene.all_clutter()
     out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    partial = out.with_name(out.name + ".partial")
-    rec = rr.RecordingStream("astralis_des", recording_id=f"world-{world.name}-{seed}")
-    rec.save(partial, default_blueprint=_overview(world))
-    log_solids(rr, rec, world)
-    log_rooms(rr, rec, world, {rid: RoomState(0.0, values[rid], "minimal") for rid in ids})
-    log_furniture(rr, rec, placed, world)
-    rec.flush()
-    rec.disconnect()
-    os.replace(partial, out)
+    with Staging(out, file=True) as folder:  # in place whole, or not at all
+        rec = rr.RecordingStream("astralis_des", recording_id=f"world-{world.name}-{seed}")
+        rec.save(folder / out.name, default_blueprint=_overview(world))
+        log_solids(rr, rec, world)
+        log_rooms(rr, rec, world, {rid: RoomState(0.0, values[rid], "minimal") for rid in ids})
+        log_furniture(rr, rec, placed, world)
+        with contextlib.suppress(RuntimeError):  # a write failed: the read-back says why
+            rec.flush()
+        rec.disconnect()
+        check_recording(folder / out.name)
     return Shown(out, len(ids), Counter(p.kind for p in placed), scene.skipped())
 
 

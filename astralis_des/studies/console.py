@@ -12,6 +12,7 @@ from rich.table import Table
 
 from astralis_des.errors import InputError
 from astralis_des.exits import EXIT_INTERRUPTED
+from astralis_des.outdir import holding
 from astralis_des.studies.backends import make_backend
 from astralis_des.studies.reports import TextTable, report
 from astralis_des.studies.runner import run_scenario, run_study
@@ -36,10 +37,11 @@ def study_command(args: argparse.Namespace) -> int:
     out = Path(args.out or Path("out") / study.name)
     console = Console(stderr=True, quiet=args.quiet)
     try:
-        result = with_progress(console, study.name, "scenarios", study.scenarios,
-                               lambda progress: run_study(
-            study, workers=args.workers, backend=args.backend, address=args.address, out=out,
-            recordings=True if args.recordings else None, progress=progress))
+        with holding(out):  # a second writer is refused before any scenario runs
+            result = with_progress(console, study.name, "scenarios", study.scenarios,
+                                   lambda progress: run_study(
+                study, workers=args.workers, backend=args.backend, address=args.address,
+                out=out, recordings=True if args.recordings else None, progress=progress))
     except KeyboardInterrupt:  # before the first scenario was under way
         console.print("[yellow]interrupted[/]; nothing written")
         return EXIT_INTERRUPTED

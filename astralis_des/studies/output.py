@@ -12,10 +12,7 @@
 
 from __future__ import annotations
 
-import json
-import os
 import platform
-import shutil
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -23,7 +20,7 @@ from typing import TYPE_CHECKING
 
 import pyarrow as pa
 
-from astralis_des.errors import InputError
+from astralis_des.outdir import Staging, dumps, result_files
 from astralis_des.studies.results import WRITERS
 from astralis_des.studies.table import write_table
 
@@ -31,28 +28,21 @@ if TYPE_CHECKING:
     from astralis_des.studies.results import StudyResult
 
 
+STUDY_FILES = result_files("table.csv", "table.parquet", "summary.csv", "summary.parquet",
+                           "report.md", "plots", "study.yaml", "meta.json", "failures.txt",
+                           "scenarios", key="meta.json")
+
+
 @contextmanager
 def staging(folder: Path | None) -> Iterator[Path | None]:
-    """A fresh hidden folder beside ``folder``, renamed to it on success, removed otherwise."""
+    """The study folder's staging (:class:`~astralis_des.outdir.Staging`): a hidden folder
+    beside ``folder``, locked against a second writer, put in place on success (``meta.json``
+    last), removed otherwise."""
     if folder is None:
         yield None
         return
-    if folder.exists() and not folder.is_dir():
-        raise InputError(f"{folder} exists and is not a folder", key="--out")
-    folder.parent.mkdir(parents=True, exist_ok=True)
-    tmp = folder.parent / f".{folder.name}.partial-{os.getpid()}"
-    shutil.rmtree(tmp, ignore_errors=True)
-    tmp.mkdir()
-    try:
+    with Staging(folder, owned=STUDY_FILES, last="meta.json") as tmp:
         yield tmp
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    old = folder.parent / f".{folder.name}.old-{os.getpid()}"
-    if folder.exists():
-        folder.rename(old)
-    tmp.rename(folder)
-    shutil.rmtree(old, ignore_errors=True)
 
 
 @WRITERS.register("folder")
@@ -81,7 +71,7 @@ def fill_folder(result: StudyResult, folder: Path) -> None:
             "backend": result.backend, "workers": result.workers,
             "wall_time_s": round(result.wall_time, 3), "python": platform.python_version(),
             "mission": str(study.mission.path) if study.mission.path else None}
-    (folder / "meta.json").write_text(json.dumps(meta, indent=2) + "\n", encoding="utf-8")
+    (folder / "meta.json").write_text(dumps(meta, indent=2) + "\n", encoding="utf-8")
     if result.failures:
         (folder / "failures.txt").write_text("\n".join(result.failures), encoding="utf-8")
     if study.spec.outputs.plots:

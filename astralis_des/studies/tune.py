@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from astralis_des.errors import InputError
+from astralis_des.outdir import journal_dumps, journal_loads
 from astralis_des.studies.backends import Backend, make_backend
 from astralis_des.studies.runner import run_study
 from astralis_des.studies.table import Z95, two_proportion_z
@@ -254,7 +255,7 @@ def _start(tune: Tune, folder: Path | None, resume: bool) -> list[dict[str, Any]
     header = {"tune": tune.name, "fingerprint": _fingerprint(tune)}
     if resume and journal.is_file():
         lines = journal.read_text(encoding="utf-8").splitlines()
-        first = json.loads(lines[0]) if lines else {}
+        first = journal_loads(lines[0]) if lines else {}
         if first.get("fingerprint") != header["fingerprint"]:
             raise InputError(f"{journal} is of another tune (or of this one before its file "
                              "or its study's changed): run without --resume, or give "
@@ -262,12 +263,12 @@ def _start(tune: Tune, folder: Path | None, resume: bool) -> list[dict[str, Any]
         done = []
         for line in lines[1:]:
             try:
-                done.append(json.loads(line))
+                done.append(journal_loads(line))
             except json.JSONDecodeError:  # the last line of a killed run
                 break
         done = done[:tune.spec.trials]
-        journal.write_text("".join(json.dumps(r, default=str) + "\n"
-                                   for r in [header, *done]), encoding="utf-8")
+        journal.write_text("".join(journal_dumps(r) + "\n" for r in [header, *done]),
+                           encoding="utf-8")
         return done
     folder.mkdir(parents=True, exist_ok=True)
     for name in TUNE_FILES:  # never a file of an earlier tune beside this one's
@@ -278,7 +279,7 @@ def _start(tune: Tune, folder: Path | None, resume: bool) -> list[dict[str, Any]
             shutil.rmtree(path)
         else:
             path.unlink(missing_ok=True)
-    journal.write_text(json.dumps(header) + "\n", encoding="utf-8")
+    journal.write_text(journal_dumps(header) + "\n", encoding="utf-8")
     return []
 
 
@@ -286,4 +287,4 @@ def _append(folder: Path | None, record: dict[str, Any]) -> None:
     if folder is None:
         return
     with (folder / JOURNAL).open("a", encoding="utf-8") as f:
-        f.write(json.dumps(record, default=str) + "\n")
+        f.write(journal_dumps(record) + "\n")

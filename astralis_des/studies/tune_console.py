@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import shutil
 from pathlib import Path
 
 from rich.console import Console
@@ -10,10 +11,11 @@ from rich.markdown import Markdown
 
 from astralis_des.errors import InputError
 from astralis_des.exits import EXIT_INTERRUPTED
+from astralis_des.outdir import Staging
 from astralis_des.studies.backends import make_backend
 from astralis_des.studies.console import with_progress
 from astralis_des.studies.tune import run_tune
-from astralis_des.studies.tune_output import report
+from astralis_des.studies.tune_output import JOURNAL, TUNE_FILES, report
 from astralis_des.studies.tune_spec import Tune, load_tune
 
 
@@ -28,15 +30,29 @@ def tune_command(args: argparse.Namespace) -> int:
         raise InputError(exc.message, key=f"--{exc.key}") from None
     out = Path(args.out or Path("out") / tune.name)
     console = Console(stderr=True, quiet=args.quiet)
-    result = with_progress(console, tune.name, "trials", tune.spec.trials,
-                           lambda progress: run_tune(
-        tune, workers=args.workers, backend=args.backend, address=args.address, out=out,
-        resume=args.resume, progress=progress))
-    if result.interrupted:
-        console.print(f"[yellow]interrupted[/]; the {len(result.rows)} trials done are in "
-                      f"{out}/ (go on with --resume)")
+    try:
+        with Staging(out, owned=TUNE_FILES, last="meta.json", keep_interrupted=True,
+                     reuse=args.resume) as folder:
+            if args.resume:
+                _journal_from(out, folder)
+            result = with_progress(console, tune.name, "trials", tune.spec.trials,
+                                   lambda progress: run_tune(
+                tune, workers=args.workers, backend=args.backend, address=args.address,
+                out=folder, resume=args.resume, progress=progress))
+            if result.interrupted:
+                raise KeyboardInterrupt  # the folder goes in place as it is
+    except KeyboardInterrupt:
+        console.print(f"[yellow]interrupted[/]; the trials done are in {out}/ (go on with "
+                      "--resume)")
         return EXIT_INTERRUPTED
     if not args.quiet:
         Console().print(Markdown("\n".join(report(result))))
         Console().print(f"{len(result.rows)} trials; outputs: {out}/")
     return 0
+
+
+def _journal_from(out: Path, folder: Path) -> None:
+    """The journal to resume: a killed tune's, left in the staging folder, else the one in
+    place (copied: the folder in place stays as it is until this tune ends)."""
+    if not (folder / JOURNAL).is_file() and (out / JOURNAL).is_file():
+        shutil.copyfile(out / JOURNAL, folder / JOURNAL)

@@ -1,26 +1,26 @@
 """A tune's folder: the trials table (CSV, Parquet), the best trial or the front (JSON), plots
 of each aim against each parameter and of the front, a report, the tune file and its meta.
 
-The journal (``trials.jsonl``) is written as trials end; these files are written (each
-atomically) when the tune ends or is interrupted.
+The journal (``trials.jsonl``) is written as trials end; these files when the tune ends or is
+interrupted, all in a staging folder put in place at the end (``astralis tune``: a killed tune
+leaves its journal there, and ``--resume`` goes on from it).
 """
 
 from __future__ import annotations
 
-import json
 import math
 import platform
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from astralis_des.sinks import write_atomic
+from astralis_des.outdir import dumps, finite, result_files, write_file
 from astralis_des.studies.table import Z95, write_table
 from astralis_des.studies.tune_spec import Tune
 
 JOURNAL = "trials.jsonl"
-TUNE_FILES = (JOURNAL, "trials.csv", "trials.parquet", "best.json", "report.md", "tune.yaml",
-              "meta.json", "plots")
+TUNE_FILES = result_files(JOURNAL, "trials.csv", "trials.parquet", "best.json", "report.md",
+                          "tune.yaml", "meta.json", "plots", key="meta.json")
 
 
 @dataclass
@@ -48,15 +48,15 @@ def write_tune(result: TuneResult, folder: Path) -> None:
         columns = list(dict.fromkeys(["trial", *(k for r in result.rows for k in r)]))
         table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in result.rows])
         write_table(table, folder, "trials")
-    write_atomic(folder / "best.json", json.dumps(result.best, indent=2) + "\n")
-    write_atomic(folder / "report.md", "\n".join(report(result)) + "\n")
-    write_atomic(folder / "tune.yaml", result.tune.text)
+    write_file(folder / "best.json", dumps(finite(result.best), indent=2) + "\n")
+    write_file(folder / "report.md", "\n".join(report(result)) + "\n")
+    write_file(folder / "tune.yaml", result.tune.text)
     meta = {"astralis_des": __version__, "tune": result.tune.name, "seed": result.tune.spec.seed,
             "sampler": result.tune.spec.sampler, "trials": len(result.rows),
             "trials_asked": result.tune.spec.trials, "interrupted": result.interrupted,
             "scenarios": result.tune.study.scenarios, "wall_time_s": round(result.wall_time, 3),
             "python": platform.python_version()}
-    write_atomic(folder / "meta.json", json.dumps(meta, indent=2) + "\n")
+    write_file(folder / "meta.json", dumps(meta, indent=2) + "\n")
     if result.rows:
         write_plots(result, folder / "plots")
 

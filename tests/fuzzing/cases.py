@@ -41,6 +41,10 @@ class Case:
     study: bytes | None = None  # a study of the mission file: run ``astralis study``
     stale: bool = False  # an earlier run's files sit in the output folder
     recording: bool = False  # write the Rerun recording too (else --no-recording)
+    out: str = "out"  # the output path given, relative to the case's folder (OUTPUT_PATHS)
+
+    def out_path(self, folder: Path) -> Path:
+        return folder / self.out.split("->")[0].rstrip("/")
 
     def save(self, folder: Path) -> None:
         folder.mkdir(parents=True, exist_ok=True)
@@ -48,6 +52,9 @@ class Case:
         (folder / "world.yaml").write_bytes(self.world)
         if self.study is not None:
             (folder / "study.yaml").write_bytes(self.study)
+        if "->" in self.out:  # a symbolic link to a folder yet to be made
+            link, target = self.out.split("->")
+            (folder / link).symlink_to(target)
 
 
 @dataclass(frozen=True)
@@ -109,8 +116,17 @@ def _fidelity(mission: bytes) -> Any:
     return doc.get("fidelity") if isinstance(doc, dict) else None
 
 
+# Output paths a user gives (``Case.out``): nested folders yet to be made, a trailing slash,
+# spaces and accents, the case's own folder, a symbolic link to a folder yet to be made; and
+# ones that cannot be written: a path under a file, an existing file, a name too long for
+# the file system, /proc. Each ends in a result or in one line naming the path, exit 2.
+OUTPUT_PATHS = ("out", "deep/er/out", "out/", "dossier de sortie é", ".",
+                "link->made/later", "mission.yaml/out", "world.yaml", "x" * 300,
+                "/proc/astralis-out")
+
+
 def command(case: Case, folder: Path) -> list[str]:
-    out = str(folder / "out")
+    out = case.out if case.out.startswith("/") else str(folder / case.out.split("->")[0])
     if case.study is not None:
         return ["study", str(folder / "study.yaml"), "--out", out, "--workers", "1", "--quiet"]
     if _fidelity(case.mission) == "physics":
@@ -124,9 +140,9 @@ def run_case(case: Case, folder: Path, limit: float = 30.0) -> Outcome:
     if folder.exists():
         shutil.rmtree(folder)
     case.save(folder)
-    out = folder / "out"
-    if case.stale:
-        out.mkdir()
+    out = case.out_path(folder)
+    if case.stale and case.out in ("out", "out/", "deep/er/out"):
+        out.mkdir(parents=True)
         for name in OUTPUT_FILES:
             (out / name).write_bytes(STALE)
     before = _snapshot(out)
@@ -149,7 +165,8 @@ def run_case(case: Case, folder: Path, limit: float = 30.0) -> Outcome:
         w = caught[0]
         return Outcome("warning", seconds, f"{w.category.__name__}: {w.message} ({w.filename})")
     if code == 2:
-        return _judge_error(text, before, _snapshot(out), seconds)
+        return _judge_error(text, before, _snapshot(out), seconds,
+                            (*NAMES, case.out.split("->")[0].rstrip("/")[:40]))
     if code != 0:
         return Outcome("traceback", seconds, f"exit {code}: {text[-400:]}")
     try:
@@ -161,18 +178,21 @@ def run_case(case: Case, folder: Path, limit: float = 30.0) -> Outcome:
 
 
 def _snapshot(folder: Path) -> dict[str, bytes]:
-    if not folder.is_dir():
+    try:
+        if not folder.is_dir():
+            return {}
+    except OSError:  # a name too long
         return {}
     return {p.relative_to(folder).as_posix(): p.read_bytes()
             for p in sorted(folder.rglob("*")) if p.is_file()}
 
 
 def _judge_error(text: str, before: dict[str, bytes], after: dict[str, bytes],
-                 seconds: float) -> Outcome:
+                 seconds: float, names: tuple[str, ...] = NAMES) -> Outcome:
     lines = text.splitlines()
     if len(lines) != 1 or not lines[0].startswith("error: "):
         return Outcome("traceback", seconds, f"not one line: {text[:600]!r}")
-    if not any(name in lines[0] for name in NAMES):
+    if not any(name in lines[0] for name in names):
         return Outcome("traceback", seconds, f"names no file: {lines[0][:300]}")
     if after != before:
         changed = sorted(set(before) ^ set(after) | {k for k in before if

@@ -8,7 +8,13 @@ Three sources, mixed:
   allows, field by field (it follows the schema as it changes);
 - **mutations** (:func:`mutated`, :func:`serialised`): a key deleted, a value of another type, an
   extreme number, a string too long, a value nested thousands deep, an unknown key; then the
-  YAML text cut, spliced with YAML's own syntax, aliased into a bomb, or made invalid UTF-8.
+  YAML text cut, spliced with YAML's own syntax, aliased into a bomb, or made invalid UTF-8;
+- **bad values in their place** (:func:`world_values`, :func:`bad_points`): NaN, infinite,
+  negative or tiny sizes and origins, rooms smaller than a robot, a building off the site,
+  and starts and move commands inside a wall, a tree or a closed space, or off the site;
+- **output paths** (:func:`output_paths`): nested, with a trailing slash, accents and spaces,
+  a symbolic link, the case's own folder, and ones that cannot be written (under a file, a
+  file, a name too long, ``/proc``).
 
 ``hypothesis-jsonschema`` would give the schema part, but its 0.23 does not run on Hypothesis
 6.1xx (``'many' object has no attribute 'more'``); the schema here uses a dozen keywords.
@@ -162,6 +168,51 @@ def worlds(draw: st.DrawFn) -> dict[str, Any]:
     return world
 
 
+BAD_NUMBERS = (float("nan"), float("inf"), float("-inf"), -1.0, 0.0, 1e-9, 1e300)
+
+
+@st.composite
+def world_values(draw: st.DrawFn, world: dict[str, Any]) -> dict[str, Any]:
+    """``world`` with a bad value a hand or a converter writes: a NaN, infinite, negative, zero
+    or tiny size or origin, rooms smaller than a robot (or just big enough), walls thicker
+    than the rooms, a building off the site."""
+    world = copy.deepcopy(world)
+    building = world["buildings"][0]
+    bad = draw(st.sampled_from(BAD_NUMBERS))
+    how = draw(st.sampled_from(["origin", "site", "room", "walls", "off_site", "obstacle",
+                                "height"]))
+    if how == "origin":
+        building["origin"][draw(st.integers(0, 1))] = bad
+    elif how == "site":
+        world["site"]["size"][draw(st.integers(0, 1))] = bad
+    elif how == "room":  # 1.21 m holds the Husky (1.01 m) inside 0.2 m walls: it runs
+        width = draw(st.sampled_from([1e-9, 0.5, 1.2, 1.21, 1.5]))
+        building["room_size"] = [width, draw(st.sampled_from([1e-9, 2.0, 7.0]))]
+        building["door_width"] = min(0.9, width / 2)
+    elif how == "walls":
+        building["wall_thickness"] = draw(st.sampled_from([1e-9, 3.0, 10.0, bad]))
+    elif how == "off_site":
+        building["origin"] = [draw(st.sampled_from([-10.0, 100.0, 1e6])), 20]
+    elif how == "obstacle":
+        world["obstacles"] = [{"kind": "tree", "center": [10, bad], "size": [1, 1, 6]}
+                              if draw(st.booleans()) else
+                              {"kind": "car", "center": [10, 60], "size": [bad, 1, 1.5]}]
+    else:
+        building["floor_height"] = bad
+    return world
+
+
+def bad_points(world: dict[str, Any]) -> list[list[float]]:
+    """Points a robot cannot stand at in a sane world: in a building's south wall, on its
+    corner, in the tree, in the closed space beside the lobby, off the site."""
+    x, y = world["buildings"][0]["origin"]
+    points = [[x + 5.0, y, 0.0], [x, y, 0.0], [x + 5.0, y + 0.1, 0.0], [-3.0, 12.0, 0.0],
+              [200.0, 12.0, 0.0], [5.0, 1e5, 0.0], [5.0, -0.5, 0.0]]
+    if "obstacles" in world:
+        points.append([10.0, 60.0, 0.0])
+    return points
+
+
 def rooms_of(world: dict[str, Any]) -> list[str]:
     """Room ids of a sane world: building.floor.segment.room."""
     out = []
@@ -213,6 +264,13 @@ def missions(draw: st.DrawFn, world: dict[str, Any],
              "room": rooms[-1]}]), min_size=1, max_size=3))
     if draw(st.integers(0, 4)) == 0:
         mission["assignment"]["auto"] = False
+    if draw(st.integers(0, 5)) == 0:  # a start inside a solid or off the site
+        draw(st.sampled_from(team))["start"] = draw(st.sampled_from(bad_points(world)))
+    if draw(st.integers(0, 7)) == 0:  # a move to such a point
+        x, y, z = draw(st.sampled_from(bad_points(world)))
+        mission.setdefault("timeline", []).append(
+            {"at": 2, "event": "command", "robot": team[0]["id"], "action": "move",
+             "params": {"x": x, "y": y, "z": z}})
     return mission
 
 
@@ -338,6 +396,14 @@ def serialised(draw: st.DrawFn, doc: Any) -> bytes:
 
 
 # -- whole cases ---------------------------------------------------------------------------------
+def output_paths() -> st.SearchStrategy[str]:
+    """The ``--out`` of a case: ``out`` three times in four, else one of ``OUTPUT_PATHS``."""
+    from fuzzing.cases import OUTPUT_PATHS
+
+    return st.one_of(st.just("out"), st.just("out"), st.just("out"),
+                     st.sampled_from(OUTPUT_PATHS))
+
+
 @functools.cache
 def _schema(model: str) -> st.SearchStrategy[Any]:
     """Documents the JSON Schema of ``astralis schema`` (``--world``) allows."""
@@ -367,10 +433,13 @@ def mission_cases(draw: st.DrawFn) -> Any:
         world_bytes = draw(serialised(draw(_schema("world"))))
     elif draw(st.integers(0, 9)) == 0:
         world_bytes = draw(serialised(draw(mutated(world))))
+    elif draw(st.integers(0, 7)) == 0:
+        world_bytes = _plain(draw(world_values(world)))
     else:
         world_bytes = _plain(world)
     return Case(draw(serialised(draw(mutated(mission)))), world_bytes,
-                stale=draw(st.booleans()), recording=draw(st.integers(0, 9)) == 0)
+                stale=draw(st.booleans()), recording=draw(st.integers(0, 9)) == 0,
+                out=draw(output_paths()))
 
 
 @st.composite
@@ -381,7 +450,7 @@ def study_cases(draw: st.DrawFn) -> Any:
     world = draw(worlds())
     mission = {**draw(missions(world)), "fidelity": "kinematic", "time_limit": 300}
     return Case(_plain(mission), _plain(world), draw(serialised(draw(mutated(draw(studies()))))),
-                stale=draw(st.booleans()))
+                stale=draw(st.booleans()), out=draw(output_paths()))
 
 
 @functools.cache
