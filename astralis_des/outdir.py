@@ -21,6 +21,7 @@ import logging
 import math
 import os
 import shutil
+import stat
 import sys
 import time
 from collections.abc import Collection, Iterator
@@ -72,6 +73,21 @@ def _file_above(path: Path) -> Path | None:
         if os.path.lexists(above):
             return above if not above.is_dir() else None
     return None
+
+
+def usable(target: str | Path, *, file: bool = False) -> None:
+    """Refuse, before any work, a target that is there as the wrong thing (a file where a
+    folder goes, or the other way), or that cannot be looked at (a name too long)."""
+    try:
+        mode = os.stat(target).st_mode
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise write_failure(target, exc) from exc
+    if file and stat.S_ISDIR(mode):
+        raise InputError("is a folder: give a file name", file=target)
+    if not file and not stat.S_ISDIR(mode):
+        raise InputError("exists and is not a folder", file=target)
 
 
 @contextmanager
@@ -347,10 +363,7 @@ class Staging:
 
     def open(self) -> Path:
         """Lock the target and make the staging folder; return it."""
-        if self.file and self.full.is_dir():
-            raise InputError("is a folder: give a file name", file=self.target)
-        if not self.file and self.full.exists() and not self.full.is_dir():
-            raise InputError("exists and is not a folder", file=self.target)
+        usable(self.target, file=self.file)
         self._lock, before = _acquire(self.target)
         try:
             reused = self.reuse and self.folder.is_dir()

@@ -73,6 +73,7 @@ def test_a_cluster_with_token_auth_is_refused_in_one_line_saying_what_to_set(
                     break
             time.sleep(0.2)
         plain = {k: v for k, v in os.environ.items() if not k.startswith("RAY_AUTH")}
+        plain["RAY_gcs_server_port_wait_time_s"] = "2"  # Ray's tries to connect: 2, not 20
         done = subprocess.run(
             [sys.executable, "-m", "astralis_des.cli", "study", str(ROOT / "studies" /
              "table5.yaml"), "--scenarios", "2", "--backend", "ray", "--address",

@@ -7,8 +7,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from astralis_des.errors import InputError
 from astralis_des.mission.loader import Mission, load_mission
+from astralis_des.outdir import usable
 
 
 def mission_from_args(args: argparse.Namespace) -> tuple[Mission, Path]:
@@ -28,6 +28,5 @@ def mission_from_args(args: argparse.Namespace) -> tuple[Mission, Path]:
         assignment = mission.spec.assignment.model_copy(update={"auto": False})
         mission = mission.with_changes(assignment=assignment.model_dump())
     out = Path(args.out or mission.spec.outputs.dir or Path("out") / mission.name)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"{out} exists and is not a folder", key="--out")
+    usable(out)
     return mission, out

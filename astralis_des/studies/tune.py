@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from astralis_des.errors import InputError
-from astralis_des.outdir import journal_dumps, journal_loads
+from astralis_des.outdir import journal_dumps, journal_loads, usable
 from astralis_des.studies.backends import Backend, make_backend
 from astralis_des.studies.runner import run_study
 from astralis_des.studies.table import Z95, two_proportion_z
@@ -249,8 +249,7 @@ def _start(tune: Tune, folder: Path | None, resume: bool) -> list[dict[str, Any]
         if resume:
             raise InputError("resuming needs the output folder of the tune", key="--resume")
         return []
-    if folder.exists() and not folder.is_dir():
-        raise InputError(f"{folder} exists and is not a folder", key="--out")
+    usable(folder)
     journal = folder / JOURNAL
     header = {"tune": tune.name, "fingerprint": _fingerprint(tune)}
     if resume and journal.is_file():
