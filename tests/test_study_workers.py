@@ -17,11 +17,12 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import pytest
+from fake_backends import Interrupted
 
 from astralis_des.studies import load_study, pool, run_study
 from astralis_des.studies.backends import LocalBackend
@@ -170,17 +171,6 @@ def test_ctrl_c_before_the_first_result_writes_an_empty_folder(tmp_path: Path) -
 def test_an_interrupted_mission_study_writes_its_folder_without_plots(tmp_path: Path) -> None:
     """The plots of a mission study (time to find, outcomes) with no rows: none drawn, the
     folder written (the in-process form of the case above)."""
-    class Interrupted:  # a backend stopped before its first chunk came back
-        name, workers = "local", 2
-
-        def run(self, study: object, chunks: object, recordings: object) -> Iterator[object]:
-            raise KeyboardInterrupt
-            yield
-
-        def hold(self, base: object) -> None: ...
-
-        def close(self) -> None: ...
-
     study = load_study(OUTCOMES).with_changes(scenarios=4)
     result = run_study(study, backend=Interrupted(),  # type: ignore[arg-type]
                        out=tmp_path / "study")
