@@ -118,6 +118,8 @@ def _parser() -> argparse.ArgumentParser:
     schema.add_argument("--world", action="store_true", help="the world file's schema")
     schema.add_argument("--markdown", action="store_true", help="the mission file's reference "
                         "as a Markdown table (docs/missions.md)")
+    schema.add_argument("--events", action="store_true", help="the event log's kinds, their "
+                        "fields and levels (Markdown: docs/events.md)")
     schema.add_argument("-o", "--output", help="write to this file instead of stdout")
     return parser
 
@@ -468,6 +470,10 @@ def _schema(args: argparse.Namespace) -> int:
         from astralis_des.mission.reference import EXAMPLE, reference
 
         text = reference(Path(EXAMPLE))
+    if args.events:
+        from astralis_des.kernel.catalogue import markdown
+
+        text = markdown()
     if args.output:
         from astralis_des.outdir import Staging
 

@@ -100,6 +100,10 @@ def test_status_queue_and_events(client: Client) -> None:
     assert [e["kind"] for e in client.events(after=page["next"],
                                              kinds=["task_finished"])["events"]] == [
         "task_finished"]
+    with pytest.raises(ApiError, match="no event kind 'task_finish'; did you mean "
+                       "'task_finished'") as err:  # it selected nothing, silently
+        client.events(kinds=["task_finish"])
+    assert err.value.code == "unknown_kind"
 
 
 def test_help_lists_every_operation(client: Client) -> None:
@@ -332,12 +336,16 @@ def test_commands_are_in_the_recording(manual: Mission, tmp_path: Path) -> None:
         assert line in shown, line
 
 
-def test_events_since_a_time_in_and_out_of_time_order(manual: Mission) -> None:
+def test_events_since_a_time_in_and_out_of_time_order(manual: Mission,
+                                                      request: pytest.FixtureRequest) -> None:
     """``since`` skips ahead by bisection while the log is in time order, and still finds every
     event once a contact stamped inside a macro-step has put it out of order."""
     from astralis_des import Simulation
     from astralis_des.api.service import Clock, Service
+    from astralis_des.kernel.catalogue import EVENTS, EventKind, event
 
+    event(EventKind("probe", "a test's", ("n",)))  # a plug-in's kind
+    request.addfinalizer(lambda: EVENTS.remove("probe"))
     service = Service(Simulation(manual), Clock(running=False))
     log = service.sim.log
     for t in (1.0, 2.0, 2.0, 3.0):

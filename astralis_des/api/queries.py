@@ -13,6 +13,7 @@ from astralis_des.actions import actions_for
 from astralis_des.api.ops import OPS, Args, op
 from astralis_des.api.protocol import MAX_MESSAGE, PROTOCOL, ApiError
 from astralis_des.errors import suggest
+from astralis_des.kernel.catalogue import EVENTS
 from astralis_des.kernel.robot import Motion
 from astralis_des.version import __version__
 
@@ -208,6 +209,9 @@ def _events(svc: Session, args: EventsArgs) -> dict[str, Any]:
     ``last`` N); ``next`` is the ``after`` of the following page, ``total`` the log's length."""
     records = svc.sim.log.records
     kinds = set(args.kinds) if args.kinds is not None else None
+    for kind in sorted(kinds or ()):  # a typo would select nothing, silently
+        if kind not in EVENTS:
+            raise ApiError("unknown_kind", f"no event kind '{kind}'; {suggest(kind, EVENTS)}")
 
     start = args.after
     since = args.since

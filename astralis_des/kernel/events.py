@@ -1,4 +1,5 @@
-"""Typed event records: time, kind, robot and payload; handed to every sink as they happen."""
+"""Event records: time, kind, robot and payload, of a kind the catalogue declares
+(:mod:`astralis_des.kernel.catalogue`); handed to every sink as they happen."""
 
 from __future__ import annotations
 
@@ -8,14 +9,10 @@ from typing import Any
 import numpy as np
 import simpy
 
+from astralis_des.kernel.catalogue import EVENTS
+
 Record = dict[str, Any]
 Sink = Callable[[Record], None]
-
-# How a replay shows each kind: detections and faults stand out.
-LEVELS: dict[str, str] = {
-    "detection": "CRITICAL", "fault": "ERROR", "task_failed": "WARN", "room_given_up": "WARN",
-    "mission_end": "INFO", "assignment": "INFO", "command": "INFO", "room_change": "INFO",
-}
 
 
 class EventLog:
@@ -30,7 +27,9 @@ class EventLog:
     def emit(self, kind: str, robot: str | None = None, *, at: float | None = None,
              **payload: Any) -> Record:
         """Record an event now, or ``at`` a time between now and the next pending event (the
-        physics stepper's time inside a macro-step)."""
+        physics stepper's time inside a macro-step). A kind, or a field, the catalogue does
+        not declare is refused (``ValueError``, ``LookupError``): a bug, not a record."""
+        EVENTS.get(kind).check(robot, payload)
         t = self.env.now if at is None else at
         record: Record = {"t": round(float(t), 6), "kind": kind}
         if robot is not None:

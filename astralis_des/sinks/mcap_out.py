@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from astralis_des.errors import InputError
+from astralis_des.kernel.catalogue import EVENTS
 from astralis_des.kernel.events import Record
 from astralis_des.outdir import dumps
 from astralis_des.sinks import ros_messages as ros
@@ -39,17 +40,20 @@ JSON_TOPICS: dict[str, tuple[str, ...]] = {
     "/mission/faults": ("fault", "recover", "team_lost"),
     "/mission/commands": ("command", "cancel"),
 }
-EVENT_SCHEMA = {
-    "$schema": "https://json-schema.org/draft/2020-12/schema",
-    "title": "astralis_des event",
-    "description": "One line of events.jsonl: simulated time, kind, the robot if any, and "
-                   "the kind's payload (see docs/replay.md).",
-    "type": "object",
-    "properties": {"t": {"type": "number", "description": "simulated seconds"},
-                   "kind": {"type": "string"}, "robot": {"type": "string"}},
-    "required": ["t", "kind"],
-    "additionalProperties": True,
-}
+def event_schema() -> dict[str, Any]:
+    """The JSON Schema of ``/mission/events``: a line of events.jsonl, its kind one of the
+    catalogue's (a plug-in's too)."""
+    return {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": "astralis_des event",
+        "description": "One line of events.jsonl: simulated time, kind, the robot if any, and "
+                       "the kind's fields (docs/events.md).",
+        "type": "object",
+        "properties": {"t": {"type": "number", "description": "simulated seconds"},
+                       "kind": {"enum": list(EVENTS)}, "robot": {"type": "string"}},
+        "required": ["t", "kind"],
+        "additionalProperties": True,
+    }
 
 
 def require() -> None:
@@ -85,7 +89,7 @@ class McapWriter:
             channels: dict[str, int] = {}
             json_schema = writer.register_schema(
                 name="astralis_des/Event", encoding="jsonschema",
-                data=dumps(EVENT_SCHEMA).encode())
+                data=dumps(event_schema()).encode())
             for seq, (t, topic, typename, msg) in enumerate(messages):
                 if topic not in channels:
                     if typename == "json":

@@ -10,7 +10,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from astralis_des.kernel.events import LEVELS, Record
+from astralis_des.kernel.catalogue import level_of
+from astralis_des.kernel.events import Record
 from astralis_des.sinks import paths
 from astralis_des.sinks.blueprint import blueprint
 from astralis_des.sinks.looks import TABLE_II_COLORS, by_height, by_place, log_body, robot_colors
@@ -116,7 +117,7 @@ class RerunRecorder:
 
     def on_event(self, record: Record) -> None:
         t, kind, robot = record["t"], record["kind"], record.get("robot")
-        self._text(paths.MISSION_EVENTS).add(t, describe(record), LEVELS.get(kind, "DEBUG"))
+        self._text(paths.MISSION_EVENTS).add(t, describe(record), level_of(record))
         if robot and kind in ("task_started", "task_finished"):
             state = record["action"] if kind == "task_started" else f"idle ({record['status']})"
             self._text(paths.robot_task(robot)).add(t, f"{state} {record.get('room') or ''}",
