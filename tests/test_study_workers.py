@@ -154,6 +154,22 @@ def test_sigterm_to_the_process_group_ends_the_study_in_5_s(tmp_path: Path) -> N
     assert meta["interrupted"] is True and 0 < len(rows) == meta["rows"] < 3000
 
 
+def test_workers_end_when_the_study_is_killed(tmp_path: Path) -> None:
+    """SIGKILL to the study alone (the OOM killer picks the biggest process): its workers
+    end within seconds. (Before: each held both ends of its pipe, so it never saw its parent
+    go and waited for a scenario for ever, holding the terminal's output open: a caller
+    reading it to the end, as CI does, hung.)"""
+    proc = study_cli(tmp_path / "study", "--scenarios", "1000", "--quiet")
+    workers = workers_of(proc)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.communicate(timeout=60)  # the workers hold its stdout and stderr until they end
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and any(Path(f"/proc/{w}").exists() for w in workers):
+        time.sleep(0.05)
+    assert not [w for w in workers if Path(f"/proc/{w}").exists()]
+    assert not (tmp_path / "study").exists()
+
+
 def test_ctrl_c_before_the_first_result_writes_an_empty_folder(tmp_path: Path) -> None:
     """SIGINT to the group as soon as the workers start: exit 130, nothing on stderr under
     --quiet (no traceback), a folder of no rows marked interrupted (before: a ``KeyError:

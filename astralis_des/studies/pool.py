@@ -8,22 +8,28 @@ one dies too, the scenario's rows are failed with the reason ("worker killed by 
 the study goes on. (``multiprocessing.Pool`` waits for a dead worker's task for ever.)
 
 Workers ignore Ctrl-C and end on SIGTERM: the parent, interrupted, ends them and returns what
-came back.
+came back. A worker also ends when its parent is gone, however it went (SIGKILL, ``os._exit``):
+on Linux the kernel sends it SIGTERM (``PR_SET_PDEATHSIG``), and anywhere it holds only its own
+end of its pipe, so it reads the end of the file there.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import logging
 import multiprocessing
+import os
 import signal
+import sys
+import weakref
 from collections import deque
 from collections.abc import Generator, Sequence
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from astralis_des.exits import default_termination
+from astralis_des.exits import default_termination, deferred_interrupts
 from astralis_des.studies.scenarios import ChunkResult, failed_scenario, run_chunk
 
 if TYPE_CHECKING:
@@ -39,19 +45,35 @@ RETRIES = 1  # a scenario whose worker died is run once more
 SIGNALS = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
 STOP_WAIT = 5.0  # s a worker has to end after it is told to, before it is killed
 Job = tuple["dict[str, Any] | None", int, "Path | None"]  # (changes, scenario, recordings)
+PR_SET_PDEATHSIG = 1  # prctl(2): a signal for this process when its parent ends
+_PARENT_ENDS: weakref.WeakSet[Connection] = weakref.WeakSet()  # the parent's ends of pipes
 
 
-def _serve(conn: Connection, base: Study) -> None:
+def _orphan_proof(parent: int) -> None:
+    """In a worker: end with its parent. SIGTERM when the parent goes (Linux), and none of
+    the parent's pipe ends held open here, so a read sees the end of the file anywhere."""
+    for end in list(_PARENT_ENDS):  # its own pipe's and the earlier workers' (inherited)
+        with contextlib.suppress(OSError):
+            end.close()
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+    if os.getppid() != parent:  # it went before the kernel was asked to tell
+        os._exit(0)
+
+
+def _serve(conn: Connection, base: Study, parent: int) -> None:
     """A worker: scenarios of ``base`` (or of ``base.with_changes(**changes)``, made once per
-    changes) until told to stop."""
+    changes) until told to stop, or until its parent is gone."""
     default_termination()  # SIGTERM ends a worker
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    _orphan_proof(parent)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)
     made: tuple[dict[str, Any], Study] | None = None
     while True:
         try:
             job: Job | None = conn.recv()
-        except EOFError:  # the parent is gone
+        except (EOFError, OSError):  # the parent is gone
             return
         if job is None:
             return
@@ -61,14 +83,19 @@ def _serve(conn: Connection, base: Study) -> None:
             if made is None or made[0] != changes:
                 made = (changes, base.with_changes(**changes))
             study = made[1]
-        conn.send(run_chunk(study, [index], recordings))
+        result = run_chunk(study, [index], recordings)
+        try:
+            conn.send(result)
+        except OSError:  # the parent is gone (a broken pipe)
+            return
 
 
 class _Worker:
     def __init__(self, base: Study) -> None:
         self.conn, child = multiprocessing.Pipe()
+        _PARENT_ENDS.add(self.conn)
         self.process: BaseProcess = multiprocessing.get_context("fork").Process(
-            target=_serve, args=(child, base), daemon=True)
+            target=_serve, args=(child, base, os.getpid()), daemon=True)
         held = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
         try:
             self.process.start()
@@ -101,9 +128,12 @@ class WorkerPool:
         try:
             while todo or busy:
                 while todo and len(busy) < self.workers:
-                    worker = self._idle.pop() if self._idle else _Worker(self.base)
+                    with deferred_interrupts():  # an interrupt (a signal, or one the import
+                        # guard of exits.py raises again) lands once the worker is known, to
+                        # be ended below: never between its fork and ``busy``
+                        worker = self._idle.pop() if self._idle else _Worker(self.base)
+                        busy[worker.conn] = worker
                     worker.send((changes, todo.popleft(), recordings))
-                    busy[worker.conn] = worker
                 ready = wait([*busy, *(w.process.sentinel for w in busy.values())])
                 for worker in {w for w in busy.values()
                                if w.conn in ready or w.process.sentinel in ready}:
