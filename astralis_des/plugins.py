@@ -4,22 +4,57 @@ need the kernel, register them). Each names the modules whose import fills it, i
 the first look-up (:class:`~astralis_des.registry.Registry`'s ``plugins``).
 
 To add an action, a strategy, a fidelity or a sensor, register it in a module of your own
-and import that module before running (or add it to the ``plugins`` here)::
+and import that module before running (or add it to the ``plugins`` here). An action is one
+record (:class:`~astralis_des.action_spec.ActionSpec`), its parameters a pydantic model::
 
-    from astralis_des.plugins import ACTIONS
+    from astralis_des.action_spec import ActionParams, Number
+    from astralis_des.plugins import action
 
-    @ACTIONS.register(("uav", "zigzag"))
+    class ZigzagParams(ActionParams):
+        width: Number = Field(2.0, ge=0.5, le=20.0, description="m")
+
+    @action("zigzag", ("uav",), params=ZigzagParams)
     def zigzag(ctx, robot, task): ...
+
+A bare function registered with ``@ACTIONS.register(("uav", "zigzag"))`` takes any params.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
+from typing import Any, TypeVar
 
+from astralis_des.action_spec import ActionSpec, AnyParams
 from astralis_des.registry import Registry
 
-# (kind, name) -> action(ctx, robot, task): a generator returning an ActionResult
-ACTIONS: Registry[tuple[str, str], Any] = Registry("action", plugins=("astralis_des.actions",))
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+class ActionRegistry(Registry[tuple[str, str], ActionSpec]):
+    """``(kind, name)`` -> the action's record; a record serving several kinds is registered
+    under each."""
+
+    def register(self, key: tuple[str, str]) -> Callable[[Any], Any]:
+        add = super().register(key)
+
+        def wrap(entry: Any) -> Any:
+            add(entry if isinstance(entry, ActionSpec) else
+                ActionSpec(key[1], (key[0],), entry, params=AnyParams))
+            return entry
+
+        return wrap
+
+    def add(self, spec: ActionSpec) -> ActionSpec:
+        for kind in spec.kinds:
+            self.register((kind, spec.name))(spec)
+        return spec
+
+    def specs(self) -> list[ActionSpec]:
+        """Each record once, in the order they were registered."""
+        return list({id(s): s for _, s in self.registered()}.values())
+
+
+ACTIONS = ActionRegistry("action", plugins=("astralis_des.actions",))
 # name -> strategy(agents, rooms, weights, ...) -> Assignment
 STRATEGIES: Registry[str, Any] = Registry("assignment strategy",
                                           plugins=("astralis_des.assignment.strategies",
@@ -33,6 +68,26 @@ COSIMS: Registry[str, Any] = Registry("fidelity", plugins=("astralis_des.cosim.k
 SENSORS: Registry[str, Any] = Registry("sensor")
 
 
+def action(name: str, kinds: tuple[str, ...], **about: Any) -> Callable[[F], F]:
+    """Register ``run`` as the action ``name`` of ``kinds``; ``about``: the record's other
+    fields (``params``, ``room``, ``search``, ...)."""
+    def add(run: F) -> F:
+        ACTIONS.add(ActionSpec(name, kinds, run, doc=" ".join((run.__doc__ or "").split()),
+                               **about))
+        return run
+
+    return add
+
+
 def actions_for(kind: str) -> list[str]:
     """The names of the actions a kind has."""
     return [name for k, name in ACTIONS if k == kind]
+
+
+def check_params(kind: str, action: str, params: dict[str, Any]) -> dict[str, Any]:
+    """``params`` checked against the record of ``kind``'s ``action`` (numbers as floats); a
+    ``ValueError`` with one line naming the parameter otherwise. An action the kind does not
+    have is refused where it is looked up, not here."""
+    if (kind, action) not in ACTIONS:
+        return dict(params)
+    return ACTIONS.get((kind, action)).check(params)

@@ -29,6 +29,7 @@ class Registry(Generic[K, V]):
         self.what = what
         self._entries: dict[K, V] = {}
         self._plugins = plugins  # modules to import before the first look-up
+        self.version = 0  # counts changes: what is derived from the entries may be cached by it
 
     def _load(self) -> None:
         plugins, self._plugins = self._plugins, ()
@@ -40,12 +41,14 @@ class Registry(Generic[K, V]):
             if key in self._entries:
                 raise ValueError(f"{self.what} {key!r} is registered twice")
             self._entries[key] = entry
+            self.version += 1
             return entry
 
         return add
 
     def remove(self, key: K) -> V:
         """Take an entry out again (a plug-in tried in a test or a notebook)."""
+        self.version += 1
         return self._entries.pop(key)
 
     def get(self, key: K) -> V:
@@ -68,6 +71,12 @@ class Registry(Generic[K, V]):
         if self._plugins:
             self._load()
         return iter(sorted(self._entries, key=self._name))
+
+    def registered(self) -> list[tuple[K, V]]:
+        """The entries in the order they were registered."""
+        if self._plugins:
+            self._load()
+        return list(self._entries.items())
 
     @staticmethod
     def _name(key: object) -> str:

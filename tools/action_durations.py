@@ -20,7 +20,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from astralis_des.assignment.durations import SECONDS_PER_M2  # noqa: E402
+from astralis_des.assignment.durations import seconds_per_m2  # noqa: E402
 from astralis_des.simulation import Simulation  # noqa: E402
 from astralis_des.studies import load_study  # noqa: E402
 from astralis_des.studies.eval_mission import scenario_mission  # noqa: E402
@@ -49,7 +49,7 @@ def main() -> None:
         a = np.array(rows)
         per = a[:, 1] / a[:, 0]
         print(f"{kind:6} {action:17} {len(a):8d} {a[:, 1].mean():7.1f} {per.mean():6.3f} "
-              f"{per.std():6.3f} {SECONDS_PER_M2.get(action, float('nan')):6.3f}")
+              f"{per.std():6.3f} {seconds_per_m2(kind, action):6.3f}")
 
 
 if __name__ == "__main__":

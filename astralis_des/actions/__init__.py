@@ -1,8 +1,10 @@
 """The fundamental actions (the paper's Table I, plus human move and inspect), by registry.
 
-``ACTIONS`` maps ``(kind, name)`` to a generator function ``action(ctx, robot, task)`` that
-returns an :class:`~astralis_des.kernel.tasks.ActionResult`. New ones plug in with
-``@ACTIONS.register(("uav", "my_action"))``.
+``ACTIONS`` maps ``(kind, name)`` to the action's record
+(:class:`~astralis_des.action_spec.ActionSpec`): its generator function
+``run(ctx, robot, task)`` returning an :class:`~astralis_des.kernel.tasks.ActionResult`, its
+parameters, its room, search, duration, Table IV and chat facts. New ones plug in with
+:func:`astralis_des.plugins.action`.
 """
 
 from __future__ import annotations
@@ -12,17 +14,12 @@ from collections.abc import Callable
 from astralis_des.actions.common import ActionGen, Context
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task
-from astralis_des.plugins import ACTIONS as _ACTIONS
-from astralis_des.plugins import actions_for
-from astralis_des.registry import Registry
+from astralis_des.plugins import ACTIONS, ActionRegistry, actions_for
 
 Action = Callable[[Context, Robot, Task], ActionGen]
-ACTIONS: Registry[tuple[str, str], Action] = _ACTIONS  # held in the foundations, by name
 
-from astralis_des.actions import human, move, uav, ugv  # noqa: E402,F401  (they register)
+# Registered in this order, which is the order the chat lists each kind's verbs in (``move``,
+# every kind's, first).
+from astralis_des.actions import move, uav, ugv, human  # noqa: E402,F401,I001  (they register)
 
-# Actions that take no room (the others search, peek into or go to one; ``move`` also takes
-# a point: ``x`` and ``y`` params).
-ROOMLESS = frozenset({"hover", "take_off", "land"})
-
-__all__ = ["ACTIONS", "ROOMLESS", "Action", "actions_for"]
+__all__ = ["ACTIONS", "Action", "ActionRegistry", "actions_for"]

@@ -8,7 +8,9 @@ from typing import Any
 
 import numpy as np
 import simpy
+from pydantic import Field
 
+from astralis_des.action_spec import ActionParams, Number, Verb
 from astralis_des.actions.common import (
     ActionGen,
     Context,
@@ -23,19 +25,30 @@ from astralis_des.actions.common import (
 )
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import Task, TaskStatus
-from astralis_des.plugins import ACTIONS
+from astralis_des.plugins import action
 from astralis_des.world.model import Room
 
 SNEAK_OFFSET = 0.5  # m in front of the wall's face at least (more for a body that must turn)
 
 
-@ACTIONS.register(("ugv", "sneak_peek"))
+class PeekParams(ActionParams):
+    dwell: Number = Field(5.0, ge=0.0, le=600.0, description="s looking in from the door")
+
+
+class CorridorParams(ActionParams):
+    dwell: Number = Field(1.0, ge=0.0, le=600.0,
+                          description="s looking from each spot of the corridor")
+
+
+@action("sneak_peek", ("ugv",), params=PeekParams, search=True, seconds_per_m2=0.238,
+        table4=((False, False),), verbs=(Verb("sneak-peek", "look into a room from its door"),))
 def sneak_peek(ctx: Context, robot: Robot, task: Task) -> ActionGen:
-    """Drive to the room's door, look in from the threshold for ``dwell`` seconds (default 5)."""
+    """Drive to the room's door, look in from the threshold for ``dwell`` seconds."""
     room = room_of(ctx, task)
     if room is None:
         return failed("sneak_peek needs a room")
-    outcome = yield from _peek(ctx, robot, room, float(task.param("dwell", 5.0)))
+    seconds = PeekParams.model_validate(dict(task.params)).dwell
+    outcome = yield from _peek(ctx, robot, room, seconds)
     if isinstance(outcome, str):
         return failed(outcome)
     distance, coverage = outcome
@@ -43,10 +56,12 @@ def sneak_peek(ctx: Context, robot: Robot, task: Task) -> ActionGen:
                   distance=distance, coverage=coverage)
 
 
-@ACTIONS.register(("ugv", "observe_corridor"))
+@action("observe_corridor", ("ugv",), params=CorridorParams, search=True,
+        seconds_per_m2=0.753, table4=((True, False), (False, True), (True, True)),
+        verbs=(Verb("observe", "watch a room's corridor"),))
 def observe_corridor(ctx: Context, robot: Robot, task: Task) -> ActionGen:
     """Drive along the corridor of the room's segment and look into each of its rooms from
-    the door (``dwell`` seconds each, default 1), nearest door first: the camera looks ahead,
+    the door (``dwell`` seconds each), nearest door first: the camera looks ahead,
     so the robot turns to each door. The coverage is that of the task's room."""
     room = room_of(ctx, task)
     if room is None:
@@ -58,8 +73,9 @@ def observe_corridor(ctx: Context, robot: Robot, task: Task) -> ActionGen:
     if abs(here[0] - last) < abs(here[0] - first):
         rooms.reverse()
     distance, coverage = 0.0, 0.0
+    seconds = CorridorParams.model_validate(dict(task.params)).dwell
     for other in rooms:
-        outcome = yield from _peek(ctx, robot, other, float(task.param("dwell", 1.0)))
+        outcome = yield from _peek(ctx, robot, other, seconds)
         if isinstance(outcome, str):
             return failed(outcome)
         distance += outcome[0]

@@ -9,8 +9,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from pydantic import Field
 
-from astralis_des.action_params import check_params
-from astralis_des.actions import ACTIONS, ROOMLESS, actions_for
+from astralis_des.actions import ACTIONS, actions_for
 from astralis_des.api.ops import Args, NoArgs, op
 from astralis_des.api.protocol import MAX_PACE, MAX_TELEOP_STEP, ApiError
 from astralis_des.errors import InputError, suggest
@@ -68,17 +67,17 @@ def _task(svc: Session, args: TaskArgs) -> Robot:
     if (robot.kind, args.action) not in ACTIONS:
         raise ApiError("bad_action", f"{robot.id} is a {robot.kind} and has no action "
                        f"'{args.action}'; its actions: {', '.join(actions_for(robot.kind))}")
+    spec = ACTIONS.get((robot.kind, args.action))
     if args.room is not None:
         svc.room(args.room)
-    elif args.action not in ROOMLESS and not (args.action == "move"
-                                              and {"x", "y"} <= set(args.params)):
-        what = "a room or params x and y" if args.action == "move" else "a room"
+    elif spec.room and not (spec.point and {"x", "y"} <= set(args.params)):
+        what = "a room or params x and y" if spec.point else "a room"
         raise ApiError("bad_args", f"{args.action} needs {what}")
     for key, value in args.params.items():
         if isinstance(value, float) and not math.isfinite(value):
             raise ApiError("bad_args", f"params.{key} must be finite")
     try:
-        check_params(args.action, dict(args.params))
+        spec.check(dict(args.params))
     except ValueError as exc:
         raise ApiError("bad_args", str(exc)) from None
     if robot.faulted:

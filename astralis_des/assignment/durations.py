@@ -2,11 +2,12 @@
 distance rule (Eq. 1's: l2 for a UAV, Manhattan for the UGV and the human) at its cruise
 speed, and a Table IV action by the room's floor area.
 
-The seconds per square metre are those of the kinematic fidelity, measured over the searches of
-40 scenarios x 3 strategies of ``studies/outcomes.yaml`` (``python tools/action_durations.py``
-prints them again): a UAV flies any of its patterns in about 0.44 s/m^2, a person walks in and
-looks in 0.38 s/m^2, the UGV observes from the corridor in 0.75 s/m^2 and peeks from the door in
-0.24 s/m^2. A planner's estimate, not a promise: clutter and detours change the real time.
+The seconds per square metre (the actions' records' ``seconds_per_m2``) are those of the
+kinematic fidelity, measured over the searches of 40 scenarios x 3 strategies of
+``studies/outcomes.yaml`` (``python tools/action_durations.py`` prints them again): a UAV flies
+any of its patterns in about 0.44 s/m^2, a person walks in and looks in 0.38 s/m^2, the UGV
+observes from the corridor in 0.75 s/m^2 and peeks from the door in 0.24 s/m^2. A planner's
+estimate, not a promise: clutter and detours change the real time.
 """
 
 from __future__ import annotations
@@ -15,21 +16,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.plugins import ACTIONS
 
-SECONDS_PER_M2: dict[str, float] = {
-    "spiral_inward": 0.437,
-    "spiral_outward": 0.432,
-    "sweep_horizontal": 0.439,
-    "inspect": 0.377,
-    "observe_corridor": 0.753,
-    "sneak_peek": 0.238,
-}
 DEFAULT_SECONDS_PER_M2 = 0.5  # an action of a plug-in, not measured
 
 
-def search_seconds(action: str, area: float) -> float:
-    """Seconds a Table IV ``action`` takes in a room of ``area`` square metres."""
-    return SECONDS_PER_M2.get(action, DEFAULT_SECONDS_PER_M2) * area
+def seconds_per_m2(kind: str, action: str) -> float:
+    """The record's measure for ``kind``'s ``action``, else :data:`DEFAULT_SECONDS_PER_M2`."""
+    measured = ACTIONS.get((kind, action)).seconds_per_m2 if (kind, action) in ACTIONS else None
+    return DEFAULT_SECONDS_PER_M2 if measured is None else measured
+
+
+def search_seconds(kind: str, action: str, area: float) -> float:
+    """Seconds ``kind``'s Table IV ``action`` takes in a room of ``area`` square metres."""
+    return seconds_per_m2(kind, action) * area
 
 
 def travel_seconds(kind: str, start: NDArray[np.float64],

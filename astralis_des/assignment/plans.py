@@ -42,7 +42,7 @@ class Problem:
 
     def search(self, i: int, j: int) -> float:
         """Seconds agent ``i`` takes to search room ``j`` (its Table IV action)."""
-        return search_seconds(self.action(i, j), self.rooms[j].area)
+        return search_seconds(self.agents[i].kind, self.action(i, j), self.rooms[j].area)
 
     @cached_property
     def room_points(self) -> NDArray[np.float64]:

@@ -1,18 +1,22 @@
 """Robot lines: ``<robot> <verb> [ROOM | X Y] [VARIANT] [key=value ...] [now]``.
 
-Each kind's verbs are registered as data, keyed by (kind, verb): a UAV's ``search ROOM
-inward`` is ``spiral_inward``, a UGV's ``observe ROOM`` is ``observe_corridor``. Every action
+Each kind's verbs come from the actions' records (their ``verbs``), keyed by (kind, verb): a
+UAV's ``search ROOM inward`` is ``spiral_inward``, a UGV's ``observe ROOM`` is
+``observe_corridor``. Every action
 a robot has also answers to its own name (``sweep-horizontal``, ``sweep_horizontal``), so a
 kind this module has never heard of can still be commanded.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
+from astralis_des.action_spec import ActionSpec, Verb
 from astralis_des.chat.team import ChatError, Team, number, param_value, seconds
 from astralis_des.errors import suggest
+from astralis_des.kinds import KINDS
+from astralis_des.plugins import ACTIONS
 from astralis_des.registry import Registry
 
 ANY_KIND = "*"
@@ -53,23 +57,36 @@ def robot_verb(kind: str, verb: RobotVerb) -> None:
     _ORDER.append((kind, verb.name))
 
 
-SEARCHES = {"inward": "spiral_inward", "outward": "spiral_outward",
-            "horizontal": "sweep_horizontal", "vertical": "sweep_vertical"}
-robot_verb(ANY_KIND, RobotVerb("move", "move", "go to a room (its centre) or to a point x y",
-                               point=True))
-robot_verb("uav", RobotVerb("search", "spiral_inward", "search a room: a spiral (inward, the "
-                            "default, or outward) or a sweep (horizontal, vertical)",
-                            variants=SEARCHES))
-robot_verb("uav", RobotVerb("hover", "hover", "hold position and look around (default 10 s)",
-                            room="none", number="duration"))
-robot_verb("uav", RobotVerb("take-off", "take_off", "climb from the ground to the flight "
-                            "height", room="none"))
-robot_verb("uav", RobotVerb("land", "land", "come down onto the floor below (the next action "
-                            "takes off again)", room="none"))
-robot_verb("ugv", RobotVerb("sneak-peek", "sneak_peek", "look into a room from its door"))
-robot_verb("ugv", RobotVerb("observe", "observe_corridor", "watch a room's corridor"))
-robot_verb("human", RobotVerb("inspect", "inspect", "walk into a room and inspect it"))
-robot_verb("human", RobotVerb("search", "inspect", "the same as inspect"))
+def _help(spec: ActionSpec, verb: Verb) -> str:
+    if verb.number is None or not verb.help:
+        return verb.help
+    return f"{verb.help} (default {spec.default(verb.number):g} s)"
+
+
+def _from_actions() -> None:
+    """Each action record's chat words: the records of a kind that share a word make one
+    verb (the first the action run without a variant word); a verb every kind has alike is
+    registered once for any kind."""
+    built: dict[tuple[str, str], RobotVerb] = {}
+    for spec in ACTIONS.specs():
+        for verb in spec.verbs:
+            variant = {verb.variant: spec.name} if verb.variant else {}
+            for kind in spec.kinds:
+                had = built.get((kind, verb.word))
+                built[(kind, verb.word)] = RobotVerb(
+                    verb.word, spec.name, _help(spec, verb), variant,
+                    room="required" if spec.room else "none", point=spec.point,
+                    number=verb.number) if had is None else replace(
+                    had, help=had.help or _help(spec, verb), variants={**had.variants, **variant})
+    for (kind, word), made in built.items():
+        if all(built.get((k, word)) == made for k in KINDS):
+            if (ANY_KIND, word) not in VERBS:
+                robot_verb(ANY_KIND, made)
+        else:
+            robot_verb(kind, made)
+
+
+_from_actions()
 
 # ``uav1 queue`` is ``queue uav1``: the robot-first form of the commands about one robot.
 ROBOT_COMMANDS = ("status", "queue", "cancel")

@@ -14,9 +14,12 @@ from dataclasses import dataclass
 from functools import cache, cached_property
 
 from astralis_des.actions import ACTIONS
+from astralis_des.kinds import KINDS
 
-SEARCHES: tuple[str, ...] = ("spiral_inward", "spiral_outward", "sweep_horizontal",
-                             "sweep_vertical", "observe_corridor", "sneak_peek", "inspect")
+# The records that search a room, by kind (as in KINDS), then name: the action space's order.
+SEARCHES: tuple[str, ...] = tuple(dict.fromkeys(
+    spec.name for spec in sorted((s for s in ACTIONS.specs() if s.search),
+                                 key=lambda s: (min(KINDS.index(k) for k in s.kinds), s.name))))
 CONTINUE, WAIT, HOLD = 0, 1, 2
 SPECIAL: tuple[str, ...] = ("continue", "wait", "hold")
 

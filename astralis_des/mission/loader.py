@@ -6,10 +6,9 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from astralis_des.action_params import check_params
 from astralis_des.errors import suggest
 from astralis_des.mission.spec import CommandEvent, MissionSpec
-from astralis_des.plugins import ACTIONS, SENSORS, STRATEGIES, actions_for
+from astralis_des.plugins import ACTIONS, SENSORS, STRATEGIES, actions_for, check_params
 from astralis_des.registry import UnknownEntry
 from astralis_des.validation import check_unique_ids, validate
 from astralis_des.world.build import load_world
@@ -151,7 +150,8 @@ def _check_references(spec: MissionSpec, world: World, doc: LocatedYaml) -> None
         if isinstance(event, CommandEvent):
             for name in event.params:
                 try:
-                    check_params(event.action, {name: event.params[name]})
+                    check_params(kinds[event.robot], event.action,
+                                 {name: event.params[name]})
                 except ValueError as exc:
                     raise doc.error(("timeline", i, "params", name), str(exc)) from None
             goal = _goal(event)

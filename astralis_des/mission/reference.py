@@ -15,7 +15,9 @@ from typing import Any
 
 import yaml
 
+from astralis_des.kinds import KINDS
 from astralis_des.mission.spec import MissionSpec
+from astralis_des.plugins import ACTIONS
 
 EXAMPLE = "missions/urban_search.yaml"
 INTRO = """# Mission file reference
@@ -31,7 +33,7 @@ can name. Keys are dotted paths: `team[]` is an item of the list `team`
 `rooms.set`. The example column is the value in `{example}`,
 where it sets the key. Timeline events are told apart by `event`
 (`fault`, `recover`, `room_change`, `command`, `cancel`); a command's `params` are the
-action's own (`astralis_des/action_params.py`).
+action's own, listed per kind after this table (any other key is refused).
 
 | key | type | default | what | example |
 | --- | --- | --- | --- | --- |
@@ -46,7 +48,32 @@ def reference(example: Path | None = None) -> str:
         values = yaml.safe_load(example.read_text(encoding="utf-8")) or {}
     rows: list[str] = []
     _walk(schema, defs, "", rows, values, set())
-    return INTRO.replace("{example}", EXAMPLE) + "\n".join(rows) + "\n"
+    return INTRO.replace("{example}", EXAMPLE) + "\n".join(rows) + "\n" + action_params()
+
+
+def action_params() -> str:
+    """Each kind's actions and their params (a timeline command's ``params``), from the
+    actions' records."""
+    out = ["", "## Actions and their params", "",
+           "What each kind can be commanded (`timeline[event=command].action`) and the `params`",
+           "it takes. `room`: the command names a room (`move`: or params `x` and `y`).", ""]
+    for kind in KINDS:
+        out += [f"### {kind}", "", "| action | room | param | type | default | what |",
+                "| --- | --- | --- | --- | --- | --- |"]
+        for key, spec in ACTIONS.registered():
+            if key[0] != kind:
+                continue
+            room = "required" if spec.room and not spec.point else (
+                "or x, y" if spec.room else "none")
+            props = spec.fields()
+            if not props:
+                out.append(f"| `{spec.name}` | {room} | | | | takes no params |")
+            for name, node in props.items():
+                default = "" if node.get("default") is None else _cell(node["default"])
+                out.append(f"| `{spec.name}` | {room} | `{name}` | {_type(node, {})} | "
+                           f"{default} | {_cell(node.get('description', ''))} |")
+        out.append("")
+    return "\n".join(out)
 
 
 def _resolve(node: dict[str, Any], defs: dict[str, Any]) -> dict[str, Any]:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import Field, field_validator, model_validator
 
@@ -34,6 +34,7 @@ from astralis_des.mission.types import (  # noqa: F401  (re-exported)
     Unit,
     Vec3,
 )
+from astralis_des.plugins import ACTIONS
 
 
 class MemberSpec(Strict):
@@ -184,12 +185,24 @@ class RoomChangeEvent(_At):
     sound: Sound | None = None
 
 
+def _params_by_action(schema: dict[str, Any]) -> None:
+    """The params each kind's action takes, from the actions' records (when the schema is
+    made, so the actions are registered)."""
+    schema["x-action-params"] = {
+        f"{kind}/{name}": {"type": "object", "additionalProperties": False,
+                           "properties": spec.fields()}
+        for (kind, name), spec in ACTIONS.registered()}
+
+
 class CommandEvent(_At):
     event: Literal["command"]
     robot: str
     action: str
     room: str | None = None
-    params: dict[str, float | str] = Field(default_factory=dict)
+    params: dict[str, float | str] = Field(
+        default_factory=dict, json_schema_extra=_params_by_action,
+        description="the action's own (docs/missions.md lists them per kind; this schema's "
+        "x-action-params: the model of each kind/action's)")
     preempt: bool = Field(False, description="run now, interrupting the current task")
 
 

@@ -12,7 +12,6 @@ from typing import Any
 import numpy as np
 import simpy
 
-from astralis_des.action_params import check_params
 from astralis_des.actions import ACTIONS
 from astralis_des.actions.common import MotionFailed
 from astralis_des.assignment import Agent, Assignment, RoomInfo, Weights, assign
@@ -29,7 +28,7 @@ from astralis_des.mission.loader import Mission
 from astralis_des.mission.spec import MemberSpec
 from astralis_des.navsensors import BodySamples, PoseSensors, motion_poses
 from astralis_des.planning.navigator import Navigator
-from astralis_des.plugins import SENSORS
+from astralis_des.plugins import SENSORS, check_params
 from astralis_des.sensing import GeometricSensor, Sighting
 from astralis_des.simulation.outputs import OUTPUTS
 from astralis_des.simulation.result import RunResult, build_result
@@ -145,7 +144,7 @@ class Simulation:
                 round: int | None = None, preempt: bool = False) -> simpy.Event:
         """Queue a task for a robot; the returned event succeeds with its ActionResult. A
         parameter the action does not take, or a bad value, is a ``ValueError`` (one line)."""
-        checked = check_params(action, params or {})
+        checked = check_params(self.robots[robot_id].kind, action, params or {})
         task = Task(next(self._ids), robot_id, action, room, tuple(sorted(checked.items())),
                     origin, round)
         self.log.emit("task_queued", robot_id, task=task.id, action=action, room=room,
@@ -157,7 +156,7 @@ class Simulation:
         start, travelled = self.env.now, robot.distance
         try:
             action = ACTIONS.get((robot.kind, task.action))
-            outcome = yield from action(self, robot, task)
+            outcome = yield from action.run(self, robot, task)
         except MotionFailed as failure:
             self.cosim.halt(robot)
             outcome = ActionResult(TaskStatus.FAILED, str(failure),
