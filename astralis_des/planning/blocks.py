@@ -20,6 +20,7 @@ from scipy import ndimage
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
+from astralis_des.memo import kept
 from astralis_des.world.geometry import FloatArray, polyline_length, segments_hit_boxes
 from astralis_des.world.model import World
 
@@ -152,7 +153,7 @@ class BlockField:
 
 def block_field(world: World) -> BlockField:
     """The world's block field, made once and kept with the world."""
-    cache: dict[str, BlockField] = world.__dict__.setdefault("_block_field", {})
+    cache: dict[str, BlockField] = kept(world, "block_field")
     if "field" not in cache:
         cache["field"] = BlockField(world)
     return cache["field"]

@@ -18,6 +18,7 @@ import numpy as np
 
 from astralis_des.errors import InputError
 from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.memo import kept
 from astralis_des.planning.footprint import RIM, facing, fits_turned, rectangle_free
 from astralis_des.planning.lintels import Lintels
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
@@ -227,7 +228,7 @@ class Navigator(Lintels):
     def occupied_points(self) -> FloatArray:
         """Centres of the map's occupied voxels above the ground (once per world)."""
         voxels = self.map
-        cache: dict[str, FloatArray] = voxels.__dict__.setdefault("_occupied_points", {})
+        cache: dict[str, FloatArray] = kept(voxels, "occupied_points")
         if "above" not in cache:
             cache["above"] = voxels.center_of(voxels.occupied_cells(above=0.05))
         return cache["above"]

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
+from astralis_des.memo import kept
 from astralis_des.world.geometry import FloatArray
 from astralis_des.world.model import World
 
@@ -220,7 +221,7 @@ def world_map(world: World, extra: ArrayLike | None = None, resolution: float | 
     extra_boxes = np.zeros((0, 2, 3)) if extra is None else np.asarray(extra, dtype=float)
     if len(extra_boxes):
         return _build_world_map(world, extra_boxes.reshape(-1, 2, 3), resolution, margin)
-    cache: dict[tuple[float, float], VoxelMap] = world.__dict__.setdefault("_voxel_map", {})
+    cache: dict[tuple[float, float], VoxelMap] = kept(world, "voxel_map", 16)
     key = (resolution, margin)
     if key not in cache:
         cache[key] = _build_world_map(world, extra_boxes, resolution, margin)

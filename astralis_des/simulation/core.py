@@ -1,4 +1,6 @@
-"""A :class:`Simulation` runs one mission: one SimPy environment, no global state."""
+"""A :class:`Simulation` runs one mission: one SimPy environment. Nothing of a run is global;
+what a process keeps between runs is what depends on a world alone, cached on the world
+(:mod:`astralis_des.memo` lists it), and never changes what a run computes."""
 
 from __future__ import annotations
 

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from astralis_des.errors import suggest
+from astralis_des.memo import kept
 from astralis_des.streams import stream
 from astralis_des.world.catalogue import Catalogue, agree, avatar_size, default_catalogue
 from astralis_des.world.freespace import BoolArray, FreeSpace, room_free_space
@@ -77,13 +78,12 @@ class Occupancy:
         """Nothing placed yet; the empty room's reachability is worked out once per room
         and passage (its arrays are replaced, never changed, as footprints are placed)."""
         taken = np.zeros(space.shape, dtype=bool)
-        kept: dict[float, tuple[BoolArray, BoolArray]] = \
-            space.__dict__.setdefault("_empty_reach", {})
-        if passage not in kept:
-            kept[passage] = _reach(space, taken, passage)
-            for array in kept[passage]:
+        reach: dict[float, tuple[BoolArray, BoolArray]] = kept(space, "empty_reach", 64)
+        if passage not in reach:
+            reach[passage] = _reach(space, taken, passage)
+            for array in reach[passage]:
                 array.setflags(write=False)
-        return cls(taken, taken.copy(), keepout, *kept[passage])
+        return cls(taken, taken.copy(), keepout, *reach[passage])
 
     def settle(self, space: FreeSpace, passage: float) -> None:
         """Reachability again after footprints were stamped by hand."""

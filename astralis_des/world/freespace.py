@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from scipy import ndimage
 
 from astralis_des.errors import suggest
+from astralis_des.memo import kept
 from astralis_des.world.geometry import Box, FloatArray, boxes_array
 from astralis_des.world.model import BLOCK, World
 
@@ -255,7 +256,7 @@ def room_free_space(world: World, room_id: str, extra: Sequence[Box] = (),
         raise KeyError(f"unknown room {room_id!r}; {suggest(room_id, world.rooms)}")
     if extra:
         return _room_free_space(world, room_id, extra, cell)
-    cache: dict[tuple[str, float], FreeSpace] = world.__dict__.setdefault("_free_space", {})
+    cache: dict[tuple[str, float], FreeSpace] = kept(world, "free_space", 100_000)
     key = (room_id, cell)
     if key not in cache:
         space = _room_free_space(world, room_id, (), cell)

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from astralis_des.memo import kept
 from astralis_des.world.geometry import FloatArray, boxes_array
 from astralis_des.world.parts import BLOCK, Building, Door, Room, Segment, Solid, Space
 from astralis_des.world.routing import Router
@@ -41,10 +42,7 @@ class World:
         """A cache kept on the world for answers that depend on it and their key alone: it
         lasts as long as the world (a study's variants, a tune's trials reuse it), emptied when
         it reaches ``limit`` entries."""
-        kept: dict[Any, Any] = self.__dict__.setdefault(f"_memo_{name}", {})
-        if len(kept) >= limit:
-            kept.clear()
-        return kept
+        return kept(self, name, limit)
 
     @property
     def map_resolution(self) -> float:

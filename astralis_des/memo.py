@@ -1,0 +1,40 @@
+"""The one way the package caches: on the object an answer depends on, for as long as it lives.
+
+A world is built once per file content and process (``world.build.load_world``), so what is
+kept on it serves every mission on that world in the process: a study's variants, a tune's
+trials, a notebook's runs. Each cache is a dict on its owner, named here, emptied when it
+reaches its limit; none is global, and none changes what a run computes (each holds what its
+key alone determines: event logs are the same with every cache empty).
+
+What is kept, on what (``kept(owner, NAME)``):
+
+- on a **world**: ``voxel_map`` (the planner's occupancy map, by resolution and margin),
+  ``block_field`` (an imported world's blocks, for going round them), ``free_space`` (each
+  room's free floor, by cell size), ``furnished`` (a room's furniture, by its draw),
+  ``coverage`` and ``first_pass`` (how much of a room a sweep sees), ``sky`` (the GNSS's open
+  sky), ``ducked`` (legs that duck under a lintel), and its router's Dijkstra rows
+  (``world.routing``, its own cache, at most 256 MB);
+- on a **voxel map**: ``occupied_points`` (its occupied cells' centres);
+- on a room's **free space**: ``empty_reach`` (where a robot reaches in the empty room).
+
+Elsewhere, once per process and by value (``functools``): the packaged clutter catalogue, the
+ROS 2 message types, a camera's swath by view and height, a catalogue without its furniture.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+NAMES = frozenset({"voxel_map", "block_field", "free_space", "furnished", "coverage",
+                   "first_pass", "sky", "ducked", "occupied_points", "empty_reach"})
+
+
+def kept(owner: object, name: str, limit: int | None = None) -> dict[Any, Any]:
+    """The cache ``name`` kept on ``owner`` (made empty the first time), emptied when it holds
+    ``limit`` entries. ``name`` is one of :data:`NAMES`, each documented above."""
+    if name not in NAMES:
+        raise KeyError(f"cache {name!r} is not one of astralis_des.memo.NAMES: document it")
+    cache: dict[Any, Any] = owner.__dict__.setdefault(f"_memo_{name}", {})
+    if limit is not None and len(cache) >= limit:
+        cache.clear()
+    return cache
