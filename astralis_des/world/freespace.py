@@ -106,11 +106,11 @@ def _points_in_triangles(points: FloatArray, tri: FloatArray) -> BoolArray:
     d00, d01, d11 = (v0 * v0).sum(-1), (v0 * v1).sum(-1), (v1 * v1).sum(-1)
     d20, d21 = (v2 * v0).sum(-1), (v2 * v1).sum(-1)
     denom = d00 * d11 - d01 * d01
-    with np.errstate(divide="ignore", invalid="ignore"):
+    eps = 1e-9
+    with np.errstate(divide="ignore", invalid="ignore"):  # a triangle of no area: denom 0
         v = (d11 * d20 - d01 * d21) / denom
         w = (d00 * d21 - d01 * d20) / denom
-    eps = 1e-9
-    inside = (denom > 0) & (v >= -eps) & (w >= -eps) & (v + w <= 1 + eps)
+        inside = (denom > 0) & (v >= -eps) & (w >= -eps) & (v + w <= 1 + eps)
     return np.asarray(inside.any(axis=1))
 
 

@@ -34,6 +34,7 @@ class Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
+MIN_WALL = 0.05  # m: a wall 1e-9 m thick made rooms of triangles of no area
 MAX_ROOMS = 10_000  # rooms of a world: loaded and routed in 0.6 s and 0.14 GB (bench_world)
 ROBOT = KIND_DEFAULTS[LARGEST].length  # m: a room or a corridor must hold the longest body
 
@@ -52,7 +53,8 @@ class BuildingSpec(Strict):
     origin: Vec2 = Field(description="south-west corner of the footprint, metres")
     floors: PositiveInt
     floor_height: Length = 3.5
-    wall_thickness: Length = 0.2
+    wall_thickness: Length = Field(0.2, ge=MIN_WALL, description="m; at least 0.05 (a "
+                                   "thinner wall is one no sensor or physics body can see)")
     room_size: tuple[Length, Length] = Field(
         (4.0, 7.0), validate_default=True, description="room width along the corridor and "
         "depth away from it, walls included: inside them, each side at least as long as the "
