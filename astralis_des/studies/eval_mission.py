@@ -40,10 +40,38 @@ METRICS = (
 )
 
 
+def renamed_robots(study: Study, s: Setting) -> dict[str, str]:
+    """The mission's robot ids -> the ids the variant's team gives the same members (the
+    k-th of each kind): uav1, uav2, ugv1, human1 in kind order."""
+    by_kind = {kind: [m.id for m in study.mission.spec.team if m.kind == kind] for kind in KINDS}
+    return {by_kind[kind][k]: ident for ident, kind, k in team_ids(s.team)
+            if k < len(by_kind[kind])}
+
+
+def unmatched_robots(study: Study, s: Setting) -> list[str]:
+    """The robots the mission's timeline names that the variant's team has no member for."""
+    renamed = renamed_robots(study, s)
+    named = [getattr(e, "robot", None) for e in study.mission.spec.timeline]
+    return sorted({r for r in named if r is not None and r not in renamed})
+
+
+def _timeline(study: Study, s: Setting) -> list[dict[str, Any]] | None:
+    """The mission's timeline with its robots under the team's ids (None: unchanged)."""
+    renamed = renamed_robots(study, s)
+    events = [e.model_dump(mode="json") for e in study.mission.spec.timeline]
+    moved = [e for e in events if e.get("robot") is not None and renamed[e["robot"]] != e["robot"]]
+    for event in moved:
+        event["robot"] = renamed[event["robot"]]
+    return events if moved else None
+
+
 def scenario_mission(study: Study, scenario: Scenario, s: Setting, outputs: bool) -> Mission:
-    """The mission a scenario runs under a variant's setting (checked like a file)."""
+    """The mission a scenario runs under a variant's setting (checked like a file). The team
+    takes the ids of the variant's mix (uav1, ..., human1), and the timeline's fault, recover,
+    command and cancel events follow the members they named."""
     base = study.mission.spec
     by_kind = {kind: [m for m in base.team if m.kind == kind] for kind in KINDS}
+    timeline = _timeline(study, s)
     team = []
     for ident, kind, k in team_ids(s.team):
         like = by_kind[kind][k % len(by_kind[kind])] if by_kind[kind] else None
@@ -57,10 +85,12 @@ def scenario_mission(study: Study, scenario: Scenario, s: Setting, outputs: bool
     assignment = base.assignment.model_dump(mode="json")
     assignment.update(strategy=s.strategy, weights=s.weights, high_risk=s.high_risk,
                       high_messiness=s.high_messiness, options=s.options)
+    changes: dict[str, Any] = {} if timeline is None else {"timeline": timeline}
     return study.mission.with_changes(
         seed=scenario.seed, fidelity=s.fidelity, time_limit=s.time_limit, team=team,
         rooms=rooms, assignment=assignment,
-        outputs={"dir": None, "events": outputs, "summary": outputs, "recording": outputs})
+        outputs={"dir": None, "events": outputs, "summary": outputs, "recording": outputs},
+        **changes)
 
 
 @evaluation("mission", METRICS, tradeoff=("human_high_risk_s", "ugv_high_mess_s"))

@@ -173,8 +173,26 @@ def _build(spec: StudySpec, mission: Mission, doc: LocatedYaml, text: str) -> St
     if spec.draw.segment != "random":
         segments = (spec.draw.segment,)
     variants = _variants(spec, doc, setting)
-    return Study(spec, mission, variants, spec.draw.positions.sampler(mission), segments, text,
-                 None if str(doc.file).startswith("<") else doc.file)
+    study = Study(spec, mission, variants, spec.draw.positions.sampler(mission), segments, text,
+                  None if str(doc.file).startswith("<") else doc.file)
+    if spec.evaluate == "mission":
+        _check_timeline_robots(study, doc)
+    return study
+
+
+def _check_timeline_robots(study: Study, doc: LocatedYaml) -> None:
+    """Each robot the mission's timeline names has a member in every variant's team (its
+    fault or command would otherwise fail every scenario)."""
+    from astralis_des.studies.eval_mission import unmatched_robots
+
+    for variant in study.variants:
+        missing = unmatched_robots(study, variant.setting)
+        if missing:
+            team = ", ".join(f"{n} {k}" for k, n in variant.setting.team.items() if n)
+            raise doc.error(("mission",), f"the mission's timeline names {', '.join(missing)}, "
+                            f"and variant '{variant.name}' has no such member (its team: "
+                            f"{team or 'none'}); give the study a team with it, or drop those "
+                            "events from the mission")
 
 
 def _factor(spec: StudySpec, doc: LocatedYaml, path: KeyPath) -> Any:
