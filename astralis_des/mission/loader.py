@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from astralis_des.errors import suggest
+from astralis_des.mission.imports import load_entry_points, load_named
 from astralis_des.mission.spec import CommandEvent, MissionSpec
 from astralis_des.plugins import ACTIONS, SENSORS, STRATEGIES, actions_for, check_params
 from astralis_des.registry import UnknownEntry
@@ -59,6 +60,8 @@ class Mission:
 def load_mission(path: str | Path) -> Mission:
     """Read a mission file; any problem is an :class:`InputError` naming file, line and key."""
     doc = load_yaml(path)
+    load_entry_points()  # installed packages' plug-ins, then the mission's own: their
+    load_named(doc)  # actions, strategies and sensors are names the mission may use
     spec = _validate(doc)
     world = load_world(doc.file_at(("world",), spec.world, "world file"))
     _check_references(spec, world, doc)

@@ -306,6 +306,10 @@ class MissionSpec(Strict):
     name: FileName = Field(description="a plain file name (letters, digits and _ . -; not . "
                            "or ..): also the output folder's name (out/NAME)")
     world: str = Field(description="world file, relative to the mission file")
+    plugins: list[str] = Field(default_factory=list, description="modules imported before "
+                               "the mission is read, whose actions, strategies, sensors and "
+                               "event kinds it may name: a .py file (relative to the mission "
+                               "file) or a module on the path (docs/architecture.md)")
     seed: int = Field(0, ge=0, description="every random draw derives from it")
     fidelity: Literal["kinematic", "physics"] = "kinematic"
     time_limit: PositiveFloat = 3600.0
