@@ -14,7 +14,6 @@ from astralis_des.api.ops import OPS, Args, op
 from astralis_des.api.protocol import MAX_MESSAGE, PROTOCOL, ApiError
 from astralis_des.errors import suggest
 from astralis_des.kernel.catalogue import EVENTS
-from astralis_des.kernel.robot import Motion
 from astralis_des.version import __version__
 
 if TYPE_CHECKING:
@@ -263,13 +262,8 @@ def robot_state(svc: Session, robot: Robot) -> dict[str, Any]:
 
 def heading_of(robot: Robot, now: float) -> float:
     """Radians from +x: along the kinematic path, or from the physics body."""
-    motion: Any = robot.motion
-    if isinstance(motion, Motion):
-        return motion.heading_at(now, robot.heading)
-    driver = getattr(motion, "driver", None)
-    if driver is not None:
-        v = driver.heading_vector()
-        return float(np.arctan2(v[1], v[0]))
+    if robot.motion is not None:
+        return robot.motion.heading_at(now, robot.heading)
     return float(robot.heading)
 
 

@@ -5,14 +5,15 @@
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
 
+from astralis_des.kernel.contracts import CoSim, Host
 from astralis_des.plugins import COSIMS
 
 __all__ = ["COSIMS", "load_fidelity"]
 
 
-def load_fidelity(name: str) -> Any:
+def load_fidelity(name: str) -> Callable[[Host], CoSim]:
     """The co-simulation class of a fidelity; physics is imported only when asked for."""
     if name == "physics" and name not in COSIMS:
         from astralis_des.cosim import physics  # noqa: F401

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import simpy
 
-from astralis_des.kernel.contracts import Host, MotionOutcome, Sensor
+from astralis_des.kernel.contracts import BodyPose, CoSim, Host, MotionOutcome, Perceived, Sensor
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.plugins import COSIMS
 
@@ -22,6 +23,16 @@ ARRIVED = MotionOutcome(True, "arrived")
 class KinematicCoSim:
     def __init__(self, sim: Host) -> None:
         self.env = sim.env
+
+    @property
+    def body_pose(self) -> BodyPose | None:
+        """No simulated body: poses come from the motions."""
+        return None
+
+    @property
+    def perception(self) -> Perceived | None:
+        """No sensors of its own: sensing is geometric (the run's ``Sensor``)."""
+        return None
 
     def execute(self, robot: Robot, motion: Motion) -> simpy.Event:
         """An event that succeeds with the motion's outcome when the robot arrives."""
@@ -58,3 +69,7 @@ class KinematicCoSim:
 
     def close(self) -> None:
         """Nothing to release; the physics fidelity frees its client here."""
+
+
+if TYPE_CHECKING:  # the contract, as mypy checks it
+    _FIDELITY: Callable[[Host], CoSim] = KinematicCoSim

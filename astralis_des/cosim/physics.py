@@ -15,16 +15,16 @@ import shutil
 import tempfile
 from collections.abc import Callable, Generator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import simpy
 
 from astralis_des.detection import Sighting
-from astralis_des.kernel.contracts import Host, MotionOutcome, Sensor
+from astralis_des.kernel.contracts import CoSim, Host, MotionOutcome, Sensor
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.physics.client import PhysicsClient
-from astralis_des.physics.drivers import DRIVERS, Driver, HumanDriver
+from astralis_des.physics.drivers import DRIVERS, Driver, DriverClass, HumanDriver
 from astralis_des.physics.hexacopter import write_urdf
 from astralis_des.physics.lift import Lift, lifts_of
 from astralis_des.physics.local import RATE as LOCAL_RATE
@@ -220,10 +220,8 @@ class PhysicsCoSim:
         """Turn on the spot to ``heading``: the UGV turns its body; others look at once."""
         self.halt(robot)
         robot.heading = heading
-        driver = self.drivers[robot.id]
-        if not hasattr(driver, "turn_to"):
+        if not self.drivers[robot.id].turn_to(heading):
             return self.env.timeout(0.0, value=MotionOutcome(True, "arrived"))
-        driver.turn_to(heading)
         return self._activate(robot, TURN_CAP)
 
     def _activate(self, robot: Robot, cap: float) -> simpy.Event:
@@ -231,7 +229,7 @@ class PhysicsCoSim:
         track = Track(self.drivers[robot.id], self.env.now, cap)
         track.sample(self.env.now)
         track.best = (track.driver.progress(), self.env.now)
-        robot.begin(track, self.env.now)  # type: ignore[arg-type]
+        robot.begin(track, self.env.now)
         done = self.env.event()
         self.active[robot.id] = (robot, track, done)
         self._place_movers()
@@ -403,3 +401,10 @@ class PhysicsCoSim:
             self.log.emit("contact", key[0], at=self.t, other=key[1],
                           impulse=round(impulses[key], 4))
         self.touching = now
+
+
+if TYPE_CHECKING:  # the contracts, as mypy checks them: this fidelity, and each body's driver
+    from astralis_des.physics.uav_driver import UavDriver
+
+    _FIDELITY: Callable[[Host], CoSim] = PhysicsCoSim
+    _DRIVERS: tuple[DriverClass, ...] = (HumanDriver, UavDriver, UgvDriver)

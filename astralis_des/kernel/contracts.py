@@ -9,6 +9,10 @@ plug-ins and wires them; the plug-ins import only the kernel and what lies below
 - :class:`Host`: what a run offers a co-simulation and its sensors (time, the event log,
   the mission, the world and its scene, the robots, the routes, the target).
 - :class:`CoSim`: a fidelity; it turns each robot's motions and looks into simulated time.
+  What only some fidelities can do is declared, not probed: ``body_pose`` and
+  ``perception`` are ``None`` where the fidelity simulates no body and no sensor of its own.
+- :class:`Perceived`: what a fidelity's own sensors kept (the physics fidelity's
+  ``Perception``), for the sinks and the result.
 - :class:`Sensor`: the geometric sensing a co-simulation consults (kinematic detection and
   coverage).
 - :class:`Context`: what an action gets (``action(ctx, robot, task)``).
@@ -18,9 +22,9 @@ plug-ins and wires them; the plug-ins import only the kernel and what lies below
 
 from __future__ import annotations
 
-from collections.abc import Generator
+from collections.abc import Callable, Generator, Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 if TYPE_CHECKING:
     import simpy
@@ -79,9 +83,46 @@ class Sensor(Protocol):
                  headings: FloatArray | None = None) -> float: ...
 
 
+BodyPose = Callable[["Robot"], tuple["FloatArray", "FloatArray"]]
+"""Where a robot's simulated body is now, and its attitude (world from body)."""
+
+
+class SensorCounts(Protocol):
+    """Wall seconds and calls per sensor (the benchmark's)."""
+
+    @property
+    def seconds(self) -> Mapping[str, float]: ...
+    @property
+    def calls(self) -> Mapping[str, int]: ...
+
+
+class Perceived(Protocol):
+    """What a fidelity's own sensors kept during a run: camera frames, lidar scans and
+    clouds, IMU traces per robot, and what they cost. The items are the fidelity's own
+    records (``astralis_des.physics.perception``'s), which the sinks, above it, name."""
+
+    @property
+    def clock(self) -> SensorCounts: ...
+    @property
+    def frames(self) -> Sequence[Any]: ...
+    @property
+    def scans(self) -> Sequence[Any]: ...
+    @property
+    def clouds(self) -> Sequence[Any]: ...
+    @property
+    def imu_traces(self) -> Mapping[str, Any]: ...
+
+
+@runtime_checkable
 class CoSim(Protocol):
     """A fidelity: each call returns an event that fires when the motion (or look, or wait)
-    is over, with a ``MotionOutcome``."""
+    is over, with a ``MotionOutcome``. ``body_pose`` and ``perception`` are capabilities:
+    ``None`` where the fidelity has no simulated body or no sensors of its own."""
+
+    @property
+    def body_pose(self) -> BodyPose | None: ...
+    @property
+    def perception(self) -> Perceived | None: ...
 
     def execute(self, robot: Robot, motion: Motion) -> simpy.Event: ...
     def watch(self, robot: Robot, motion: Motion, sensor: Sensor,
@@ -90,6 +131,8 @@ class CoSim(Protocol):
     def face(self, robot: Robot, heading: float) -> simpy.Event: ...
     def halt(self, robot: Robot) -> None: ...
     def look(self, robot: Robot, sensor: Sensor) -> Sighting | None: ...
+    def recover(self, robot: Robot) -> None: ...
+    def close(self) -> None: ...
 
 
 class Context(Protocol):

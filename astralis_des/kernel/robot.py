@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -13,6 +13,19 @@ from astralis_des.world.geometry import FloatArray
 if TYPE_CHECKING:
     from astralis_des.kernel.handler import TaskHandler
     from astralis_des.view import View
+
+
+@runtime_checkable
+class Trajectory(Protocol):
+    """What a robot follows from ``t0``, as the kernel reads it: a kinematic :class:`Motion`,
+    or a simulated body's track (the physics fidelity's ``Track``)."""
+
+    t0: float
+
+    def at(self, t: float) -> FloatArray: ...
+    def travelled(self, t: float) -> float: ...
+    def heading_at(self, t: float, before: float) -> float: ...
+    def vertices_until(self, t: float) -> tuple[FloatArray, FloatArray]: ...
 
 
 @dataclass
@@ -113,7 +126,7 @@ class Robot:
     height: float
     pose: FloatArray
     handler: TaskHandler | None = None
-    motion: Motion | None = None
+    motion: Trajectory | None = None
     faulted: bool = False
     accel: float | None = None  # m/s^2; None: starts and stops at once
     turn_rate: float | None = None  # rad/s on the spot, for a non-holonomic robot
@@ -131,7 +144,7 @@ class Robot:
     def position(self, now: float) -> FloatArray:
         return self.motion.at(now) if self.motion is not None else self.pose
 
-    def begin(self, motion: Motion, now: float) -> None:
+    def begin(self, motion: Trajectory, now: float) -> None:
         self.halt(now)
         motion.t0 = now
         self.motion = motion
@@ -141,7 +154,7 @@ class Robot:
         if self.motion is None:
             return
         times, pts = self.motion.vertices_until(now)
-        if isinstance(self.motion, Motion):
+        if isinstance(self.motion, Motion):  # a body's heading is its own (it faces, turns)
             self.heading = self.motion.heading_at(now, self.heading)
             self.history.append((self.motion.t0, now, self.motion, self.heading))
         self.trail_t.extend(times.tolist())

@@ -29,10 +29,18 @@ SAMPLE = 0.2  # m between the points of a path ahead
 
 
 class Driver(Protocol):
+    """A robot's body and controller. What only some bodies can do is declared here and
+    answered by each: ``turn_to`` (False: it faces any way at once), ``course_z`` (None: it
+    flies no reference course), ``blocked_by`` (empty but for a walker that waits)."""
+
     body: int
     held: bool
     shift: FloatArray
     arrive_within: float
+    blocked_by: tuple[str, ...]  # the robots it last had to wait for
+
+    def turn_to(self, heading: float) -> bool: ...
+    def course_z(self) -> float | None: ...
 
     def start(self, motion: Motion, t: float) -> None: ...
     def tick(self, t: float) -> str | None: ...
@@ -48,6 +56,9 @@ class Driver(Protocol):
     def fall(self, floor: FloatArray) -> None: ...
     def recover(self, at: FloatArray) -> None: ...
 
+
+DriverClass = Callable[[PhysicsClient, Robot, PhysicsSpec, Path], Driver]
+"""How a driver is built: ``DRIVERS.get(kind)(client, robot, spec, urdf)``."""
 
 DRIVERS: Registry[str, type] = Registry(
     "driver", plugins=("astralis_des.physics.uav_driver", "astralis_des.physics.ugv_driver"))
@@ -65,6 +76,7 @@ class Avoiding:
     lift_z: float = 0.0
     lift_to: float = 0.0
     arrive_within: float = ARRIVED
+    blocked_by: tuple[str, ...] = ()  # the robots it last had to wait for (a walker's)
 
     def _clear_avoidance(self) -> None:
         self.held = False
@@ -78,6 +90,14 @@ class Avoiding:
 
     def slow_down(self, share: float) -> None:
         """Obstacles ahead (the lidar): go at most ``share`` of the speed. Only a UGV does."""
+
+    def turn_to(self, heading: float) -> bool:
+        """Turn on the spot to ``heading``: False, it faces any way at once. Only a UGV turns."""
+        return False
+
+    def course_z(self) -> float | None:
+        """The height its reference flies at now: None, it flies none. Only a UAV does."""
+        return None
 
 
 @DRIVERS.register("human")

@@ -85,7 +85,8 @@ class LocalLayer:
             velocity = driver.heading_vector() if active and not driver.held else np.zeros(2)
             # a robot that is not moving cannot yield: it ranks with the movers
             rank = self.rank[rid] if active else STILL_RANK
-            course = driver.course_z() if active and hasattr(driver, "course_z") else here[2]
+            course = driver.course_z() if active else None
+            course = here[2] if course is None else course
             found.append(Body(rid, robot.kind, here[:2], velocity,
                               (here[2] + low, here[2] + high), RADII[robot.kind], rank,
                               (course + low, course + high), driver.shift,
@@ -163,7 +164,7 @@ class LocalLayer:
             blockers.append(in_door)
         occupant = self._goal_taken(driver, me, others)
         driver.arrive_within = GOAL_TAKEN if occupant is not None else 0.2
-        pressing = [b for b in others if b.name in getattr(driver, "blocked_by", ())]
+        pressing = [b for b in others if b.name in driver.blocked_by]
         for other in [*blockers, *([occupant] if occupant else []), *pressing]:
             if other.name in self.cosim.drivers and other.name not in self.cosim.active and \
                     self.cosim.may_ask(other.name):

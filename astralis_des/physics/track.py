@@ -35,6 +35,11 @@ class Track:
     def at(self, t: float) -> FloatArray:
         return self.driver.position()
 
+    def heading_at(self, t: float, before: float) -> float:
+        """The way the body heads now (radians from +x)."""
+        v = self.driver.heading_vector()
+        return float(np.arctan2(v[1], v[0]))
+
     def travelled(self, t: float) -> float:
         return self.odometry + float(np.linalg.norm(self.driver.position() - self.points[-1]))
 

@@ -104,8 +104,8 @@ class UgvDriver(Avoiding):
         return np.array([x, y, z - REST_Z + self.height])
 
     # -- motions ---------------------------------------------------------------------------
-    def turn_to(self, heading: float) -> None:
-        """Turn on the spot until the body faces ``heading``."""
+    def turn_to(self, heading: float) -> bool:
+        """Turn on the spot until the body faces ``heading`` (True: it turns)."""
         self.legs = []
         self.ride = None
         self.motion = None
@@ -114,6 +114,7 @@ class UgvDriver(Avoiding):
         self.turned = 0.0
         self._yaw = self.husky.pose()[3]
         self._clear_avoidance()
+        return True
 
     def start(self, motion: Motion, t: float) -> None:
         self.turning = False

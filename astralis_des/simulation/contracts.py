@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Protocol
 
-from astralis_des.kernel.contracts import Host
+from astralis_des.kernel.contracts import CoSim, Host
 
 if TYPE_CHECKING:
     import simpy
@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 class Run(Host, Protocol):
     """A run in progress."""
 
-    cosim: Any
+    cosim: CoSim
     rooms: dict[str, RoomState]  # what the mission drew for each room
     rounds: list[dict[str, Any]]  # the assignment rounds so far
     allocation_time: list[float]  # wall s of each round's assignment (not logged)

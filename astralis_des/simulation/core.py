@@ -101,8 +101,9 @@ class Simulation:
         # simulated body's is sampled at their reading times)
         self.pose_sensors = PoseSensors.of(self, motion_poses)
         self._bodies: BodySamples | None = None
-        if hasattr(self.cosim, "body_pose") and self.pose_sensors.sensors:
-            self._bodies = BodySamples(self.env, self.cosim.body_pose)
+        body_pose = self.cosim.body_pose
+        if body_pose is not None and self.pose_sensors.sensors:
+            self._bodies = BodySamples(self.env, body_pose)
             self.pose_sensors.poses = self._bodies.poses
 
     # -- set-up ----------------------------------------------------------------------------

@@ -82,7 +82,8 @@ def build_result(sim: Run, outcome: str, wall_time: float) -> RunResult:
     rooms = room_report(sim)
     target = {"room": sim.target.room, "position": list(sim.target.position),
               **sim.target.avatar}
-    clock = getattr(getattr(sim.cosim, "perception", None), "clock", None)
+    perception = sim.cosim.perception
+    clock = perception.clock if perception is not None else None
     return RunResult(
         mission=sim.mission.spec.name, seed=sim.mission.spec.seed,
         fidelity=sim.mission.spec.fidelity, outcome=outcome, end_time=now,
@@ -90,8 +91,8 @@ def build_result(sim: Run, outcome: str, wall_time: float) -> RunResult:
         found_by=detection["robot"] if detection else None, target=target, robots=stats,
         rounds=sim.rounds, rooms_searched=list(sim.searched), coverage=coverage,
         events=sim.log.records, rooms=rooms, wall_time=wall_time,
-        sensor_calls=dict(sorted(clock.calls.items())) if clock else {},
-        sensor_time=dict(sorted(clock.seconds.items())) if clock else {},
+        sensor_calls=dict(sorted(clock.calls.items())) if clock is not None else {},
+        sensor_time=dict(sorted(clock.seconds.items())) if clock is not None else {},
         allocation_time=list(sim.allocation_time))
 
 

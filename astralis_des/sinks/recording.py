@@ -136,7 +136,7 @@ class RerunRecorder:
                                                        colors=by_height(points[:, 2])),
                     static=True)
         self._log_movers(result.end_time)
-        perception = getattr(self.sim.cosim, "perception", None)
+        perception = self.sim.cosim.perception
         if perception is not None:
             log_sensors(rr, rec, perception)
         log_pose_sensors(rr, rec, self.sim.pose_sensors)

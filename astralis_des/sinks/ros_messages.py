@@ -134,7 +134,7 @@ def sensors(ty: Types, sim: Simulation) -> Iterator[Stamped]:
     and what the physics fidelity's sensors kept: camera frames (Image and CameraInfo, with
     the camera's TF), lidar scans (LaserScan) and IMU readings (Imu)."""
     yield from pose_sensors(ty, sim)
-    perception = getattr(sim.cosim, "perception", None)
+    perception = sim.cosim.perception
     if perception is None:
         return
     for frame in perception.frames:

@@ -16,8 +16,9 @@ from astralis_des.sinks import paths
 from astralis_des.sinks.looks import by_height
 
 if TYPE_CHECKING:
+    from astralis_des.kernel.contracts import Perceived
     from astralis_des.navsensors import PoseSensors
-    from astralis_des.physics.perception import KeptCloud, KeptFrame, KeptScan, Perception
+    from astralis_des.physics.perception import KeptCloud, KeptFrame, KeptScan
 
 Kept = TypeVar("Kept", "KeptFrame", "KeptScan", "KeptCloud")
 
@@ -30,7 +31,7 @@ def _by_robot(items: Sequence[Kept]) -> dict[str, list[Kept]]:
     return groups
 
 
-def log_sensors(rr: Any, rec: Any, perception: Perception) -> None:
+def log_sensors(rr: Any, rec: Any, perception: Perceived) -> None:
     for rid, frames in _by_robot(perception.frames).items():
         _log_frames(rr, rec, paths.robot_camera(rid), frames)
     for rid, kept in _by_robot(perception.scans).items():
