@@ -10,9 +10,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from astralis_des.assignment import Agent, RoomInfo, Weights, assign
-from astralis_des.kinds import KINDS
 from astralis_des.streams import stream
 from astralis_des.studies.evaluation import Metric, evaluation
+from astralis_des.studies.teams import team_ids
 
 if TYPE_CHECKING:
     from astralis_des.studies.draws import Point, Scenario
@@ -24,11 +24,6 @@ METRICS = (
     *(Metric(f"{kind}_unassigned", f"{kind.upper() if kind != 'human' else kind} unassigned",
              "rate") for kind in ("human", "uav", "ugv")),
 )
-
-
-def team_ids(team: dict[str, int]) -> list[tuple[str, str, int]]:
-    """``(id, kind, k)`` of a team mix: uav1, uav2, ugv1, human1, in kind order."""
-    return [(f"{kind}{k + 1}", kind, k) for kind in KINDS for k in range(team.get(kind, 0))]
 
 
 @evaluation("assignment", METRICS, tradeoff=("human_high_risk", "ugv_high_mess"))

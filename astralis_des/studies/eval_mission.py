@@ -11,9 +11,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from astralis_des.kinds import KINDS
-from astralis_des.studies.eval_assignment import team_ids
 from astralis_des.studies.eval_metrics import allocation_metrics
 from astralis_des.studies.evaluation import Metric, evaluation
+from astralis_des.studies.teams import renamed_robots, team_ids
 
 if TYPE_CHECKING:
     from astralis_des.mission.loader import Mission
@@ -40,24 +40,9 @@ METRICS = (
 )
 
 
-def renamed_robots(study: Study, s: Setting) -> dict[str, str]:
-    """The mission's robot ids -> the ids the variant's team gives the same members (the
-    k-th of each kind): uav1, uav2, ugv1, human1 in kind order."""
-    by_kind = {kind: [m.id for m in study.mission.spec.team if m.kind == kind] for kind in KINDS}
-    return {by_kind[kind][k]: ident for ident, kind, k in team_ids(s.team)
-            if k < len(by_kind[kind])}
-
-
-def unmatched_robots(study: Study, s: Setting) -> list[str]:
-    """The robots the mission's timeline names that the variant's team has no member for."""
-    renamed = renamed_robots(study, s)
-    named = [getattr(e, "robot", None) for e in study.mission.spec.timeline]
-    return sorted({r for r in named if r is not None and r not in renamed})
-
-
 def _timeline(study: Study, s: Setting) -> list[dict[str, Any]] | None:
     """The mission's timeline with its robots under the team's ids (None: unchanged)."""
-    renamed = renamed_robots(study, s)
+    renamed = renamed_robots(study.mission.spec, s.team)
     events = [e.model_dump(mode="json") for e in study.mission.spec.timeline]
     moved = [e for e in events if e.get("robot") is not None and renamed[e["robot"]] != e["robot"]]
     for event in moved:

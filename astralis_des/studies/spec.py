@@ -183,10 +183,10 @@ def _build(spec: StudySpec, mission: Mission, doc: LocatedYaml, text: str) -> St
 def _check_timeline_robots(study: Study, doc: LocatedYaml) -> None:
     """Each robot the mission's timeline names has a member in every variant's team (its
     fault or command would otherwise fail every scenario)."""
-    from astralis_des.studies.eval_mission import unmatched_robots
+    from astralis_des.studies.teams import unmatched_robots
 
     for variant in study.variants:
-        missing = unmatched_robots(study, variant.setting)
+        missing = unmatched_robots(study.mission.spec, variant.setting.team)
         if missing:
             team = ", ".join(f"{n} {k}" for k, n in variant.setting.team.items() if n)
             raise doc.error(("mission",), f"the mission's timeline names {', '.join(missing)}, "
