@@ -380,7 +380,7 @@ def _world_import(args: argparse.Namespace) -> int:
         max_points=args.max_points, keep_strays=args.keep_strays)
     command_line = " ".join(["astralis world import", *sys.argv[3:]]) if \
         sys.argv[1:3] == ["world", "import"] else None
-    console = Console(highlight=False, stderr=True)
+    console = Console(highlight=False, stderr=True, soft_wrap=True)  # a line is one line
     try:  # the output locked (and found writable) before the import
         with holding(args.output), _import_progress(console) as progress:
             report = import_world(args.file, args.output, options, command=command_line,
@@ -498,7 +498,7 @@ def _run(args: argparse.Namespace) -> int:
         from astralis_des.sinks.mcap_out import require
 
         require()
-    console = Console(stderr=True, quiet=args.quiet)
+    console = Console(stderr=True, quiet=args.quiet, soft_wrap=True)  # never wrapped
     made: list[Simulation] = []
 
     def run(progress: Any) -> RunResult:

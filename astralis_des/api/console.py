@@ -25,7 +25,7 @@ def serve_command(args: argparse.Namespace) -> int:
     # the sockets before the mission: a bad or busy address fails with nothing written
     server = Server(args.bind, stream=args.stream, curve_keys=args.curve_keys,
                     state_rate=args.state_rate)
-    console = Console(stderr=True, quiet=args.quiet, highlight=False)
+    console = Console(stderr=True, quiet=args.quiet, highlight=False, soft_wrap=True)
     try:
         service = Service(Simulation(mission, out_dir=out), Clock(args.pace, not args.stepped))
     except BaseException:

@@ -35,7 +35,7 @@ def study_command(args: argparse.Namespace) -> int:
     except InputError as exc:
         raise InputError(exc.message, key=f"--{exc.key}") from None
     out = Path(args.out or Path("out") / study.name)
-    console = Console(stderr=True, quiet=args.quiet)
+    console = Console(stderr=True, quiet=args.quiet, soft_wrap=True)  # never wrapped
     try:
         with holding(out):  # a second writer is refused before any scenario runs
             result = with_progress(console, study.name, "scenarios", study.scenarios,

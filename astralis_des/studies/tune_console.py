@@ -29,7 +29,7 @@ def tune_command(args: argparse.Namespace) -> int:
     except InputError as exc:
         raise InputError(exc.message, key=f"--{exc.key}") from None
     out = Path(args.out or Path("out") / tune.name)
-    console = Console(stderr=True, quiet=args.quiet)
+    console = Console(stderr=True, quiet=args.quiet, soft_wrap=True)  # never wrapped
     try:
         with Staging(out, owned=TUNE_FILES, last="meta.json", keep_interrupted=True,
                      reuse=args.resume) as folder:
