@@ -1,9 +1,14 @@
-"""What each agent kind is by default: speed, camera, height of its sensor, sensor set."""
+"""What each agent kind is: one record (:class:`KindDefaults`) carrying its speed, camera,
+sensor height and sensor set, its body (for the planners, the local layer and the lidar), how it
+moves between floors, which planner plans its legs and which rooms are its hazard. Code elsewhere
+asks the record (``KIND_DEFAULTS[kind].flies``), never compares the kind's name; a new kind is
+one more entry here (and its actions, driver and looks registered where those live)."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 
 @dataclass(frozen=True)
@@ -19,6 +24,7 @@ class CameraDefaults:
 
 @dataclass(frozen=True)
 class KindDefaults:
+    planner: str  # the entry of astralis_des.planning.planners.PLANNERS that plans its legs
     speed: float  # m/s, cruise
     camera: CameraDefaults
     height: float  # m above the floor of its sensor (a UAV's flight altitude indoors)
@@ -30,11 +36,30 @@ class KindDefaults:
     footprint: tuple[float, float] | None = None  # m, length and width of a long body
     rest: float | None = None  # m above the floor of its sensor when landed; None: it walks
     # or drives (its sensor is always at ``height``)
+    keep_out: float = 0.0  # m more kept from furniture and people than from walls
+    band: tuple[float, float] = (-0.1, 0.1)  # m below and above its pose its body takes
+    passing_radius: float | None = None  # m: the disc others pass it by (None: ``radius``)
+    half_width: float = 0.0  # m beside it others keep clear of (0: its passing radius)
+    lidar_offset: float = 0.5  # m from its centre where a lidar's rays start, outside the body
+    # between floors: the stairs, the lift (where there is one, else the stairs), or flown up
+    # the stairwell
+    floors: Literal["stairs", "lift", "well"] = "stairs"
+    hazard: Literal["risk", "messiness"] | None = None  # rooms high in it are unsafe for it
+    person: bool = False  # a person (not a robot): who teleop drives, whom robots keep from
+    label: str = ""  # its name in a table's heading (else the kind's)
+    carries: tuple[str, ...] | None = None  # the sensors it can carry (None: every one)
+    look: str = "rover"  # how a recording draws it (astralis_des.sinks.looks.LOOKS)
+    color: tuple[int, int, int] = (200, 200, 200)  # its node in a recording's round graph
 
     @property
     def flies(self) -> bool:
         """Whether it takes off and lands (a UAV): it has a resting height."""
         return self.rest is not None
+
+    @property
+    def passes_by(self) -> float:
+        """The disc others pass it by (a long body's half-diagonal)."""
+        return self.passing_radius if self.passing_radius is not None else self.radius
 
     @property
     def length(self) -> float:
@@ -59,17 +84,33 @@ KIND_DEFAULTS: dict[str, KindDefaults] = {
     # wide below the craft, mostly ahead of it. Indoors it flies over the heads of standing
     # people and under the door lintels (:func:`astralis_des.world.flight.flight_height`):
     # ``height`` is the flight height where the world sets none. It starts and ends landed.
-    "uav": KindDefaults(speed=1.5, camera=CameraDefaults(None, 90.0, 75.0, True, True),
+    # It keeps 0.2 m more from furniture and people: it cuts a corner of its path by up to a
+    # quarter metre (measured), and it should not brush a person's head.
+    "uav": KindDefaults(planner="fly", speed=1.5,
+                        camera=CameraDefaults(None, 90.0, 75.0, True, True),
                         height=UAV_FLIGHT_HEIGHT, distance="l2", sensors=("camera", "imu"),
-                        radius=0.3, accel=2.0, rest=UAV_REST),
+                        radius=0.3, accel=2.0, rest=UAV_REST, keep_out=0.2,
+                        band=(-0.1, 0.1), floors="well", label="UAV", look="rotorcraft",
+                        color=(30, 144, 255)),
     # A forward camera on the body, and a lidar the local planner slows down for.
-    "ugv": KindDefaults(speed=1.0, camera=CameraDefaults(None, 60.0, 0.0, False, False),
+    # Others pass it by its half-diagonal, and keep 0.4 m beside it (the Husky's half-width and
+    # a margin for its turning); it takes the lift; rooms high in messiness are unsafe for it.
+    "ugv": KindDefaults(planner="drive", speed=1.0,
+                        camera=CameraDefaults(None, 60.0, 0.0, False, False),
                         height=0.5, distance="manhattan", sensors=("camera", "lidar", "imu"),
                         radius=0.35, accel=1.0, turn_rate=1.0,
-                        footprint=(1.01, 0.69)),  # the Husky
+                        footprint=(1.01, 0.69),  # the Husky
+                        band=(-0.5, 0.15), passing_radius=0.62, half_width=0.4,
+                        lidar_offset=0.6, floors="lift", hazard="messiness", label="UGV",
+                        color=(255, 165, 0)),
     # A person's eyes: a wide view a little down, ahead of where they walk.
-    "human": KindDefaults(speed=1.2, camera=CameraDefaults(None, 90.0, 15.0, True, True),
-                          height=1.6, distance="manhattan", sensors=("camera",), radius=0.25),
+    # Rooms high in risk are unsafe for a person. The operator has eyes (a camera model) and
+    # nothing else.
+    "human": KindDefaults(planner="walk", speed=1.2,
+                          camera=CameraDefaults(None, 90.0, 15.0, True, True),
+                          height=1.6, distance="manhattan", sensors=("camera",), radius=0.25,
+                          band=(-1.6, 0.15), hazard="risk", person=True,
+                          carries=("camera",), look="person", color=(220, 20, 60)),
 }
 KINDS = tuple(KIND_DEFAULTS)
 LARGEST = max(KINDS, key=lambda k: KIND_DEFAULTS[k].length)  # the kind of the longest body

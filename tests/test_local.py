@@ -149,22 +149,23 @@ def test_a_walker_that_stepped_round_a_standing_ugv_is_not_held_by_it() -> None:
     way. The step round it must take the person past the lane's edge: it used to put the path
     exactly on it (0.79999 m off, the lane 0.8 m), so the person held for 15 s, until its move
     failed as stuck."""
+    from astralis_des.kinds import KIND_DEFAULTS
     from astralis_des.physics.courses import on_route
-    from astralis_des.physics.local import RADII, Body, LocalLayer
+    from astralis_des.physics.local import Body, LocalLayer
 
     # the person's path ahead and the UGV as the local layer saw them at t = 22 s
     path = np.column_stack([76.11828760509543 - 0.19963966349279 * np.arange(16),
                             78.43223407838225 + 0.01200019835202 * np.arange(16)])
     ugv = Body("ugv1", "ugv", np.array([74.12991336611312, 78.66263168889651]), np.zeros(2),
-               (0.0, 0.65), RADII["ugv"], 10_000, half_width=0.4)
+               (0.0, 0.65), KIND_DEFAULTS["ugv"].passes_by, 10_000, half_width=0.4)
     forward = np.array([-0.9981983174639202, 0.06000099176012755])
     right = np.array([forward[1], -forward[0]])
     shift = np.array([-0.04135945353275388, -0.688070908772107])  # its step aside then
-    lane = RADII["human"] + ugv.half_width + 0.15
+    lane = KIND_DEFAULTS["human"].passes_by + ugv.half_width + 0.15
     assert on_route(path + shift, ugv.xy, ugv.velocity)[1] < lane  # on the edge: held
     for _ in range(2):  # decide, step as decided, decide again
         me = Body("human1", "human", path[0] + shift, forward * 1.2, (0.0, 1.75),
-                  RADII["human"], 2, offset=shift)
+                  KIND_DEFAULTS["human"].passes_by, 2, offset=shift)
         hold, shift, aside, blockers = LocalLayer._decide(
             None, me, [ugv], forward, right, 1.2, path + shift)  # type: ignore[arg-type]
         assert aside
@@ -182,13 +183,14 @@ def test_a_uav_coming_down_from_a_lifted_point_does_not_come_down_onto_a_walker(
     down onto it and was tipped over."""
     from dataclasses import replace
 
+    from astralis_des.kinds import KIND_DEFAULTS
     from astralis_des.physics.climb import Climber
-    from astralis_des.physics.local import RADII, Body, _lowest
+    from astralis_des.physics.local import Body, _lowest
 
     ahead = np.column_stack([np.full(16, 65.1), np.linspace(71.3, 68.3, 16),
                              np.linspace(2.2, 1.5, 16)])
     uav = Body("uav2", "uav", np.array([65.1, 71.3]), np.array([0.0, -0.5]), (2.0, 2.2),
-               RADII["uav"], 1, base_z=(2.1, 2.3))
+               KIND_DEFAULTS["uav"].passes_by, 1, base_z=(2.1, 2.3))
     walker = Body("avatar", "avatar", np.array([65.1, 72.7]), np.array([0.0, -1.0]),
                   (0.0, 1.72), 0.25, 10_000)
     climber = Climber(lambda robot, points: np.ones(len(points), dtype=bool))

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from astralis_des import Mission, Simulation, load_mission
-from astralis_des.planning.navigator import BODY_RADIUS
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.world.clutter import Clutter, Placed
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -34,7 +34,7 @@ def clear_everywhere(sim: Simulation, kind: str, points: np.ndarray) -> bool:
     dense_arr = np.array(dense)
     if kind != "uav":
         dense_arr[:, 2] = sim.world.floor_below(dense_arr[0]) + 0.4
-    radius = BODY_RADIUS[kind] + sim.mission.spec.planning.margin
+    radius = KIND_DEFAULTS[kind].radius + sim.mission.spec.planning.margin
     cell = 0.1 if kind != "uav" else 0.2  # the planner's grid: clear to within a cell
     return bool(sim.navigator._valid(robot, dense_arr, radius - cell).all())
 

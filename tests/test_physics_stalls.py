@@ -12,8 +12,9 @@ from test_landing import scenario
 from test_local import contacts_between, corridor_mission
 
 from astralis_des.kernel.robot import Motion
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.physics.drivers import ARRIVED
-from astralis_des.physics.local import RADII, SAMPLE, Body, LocalLayer
+from astralis_des.physics.local import SAMPLE, Body, LocalLayer
 
 
 def test_a_uav_ducking_through_a_door_does_not_hold_for_a_person_it_will_pass_over() -> None:
@@ -27,9 +28,10 @@ def test_a_uav_ducking_through_a_door_does_not_hold_for_a_person_it_will_pass_ov
                          np.linalg.norm(b - a)) for a, b in itertools.pairwise(corners)]
     route = np.vstack(legs)[:16]
     heights = np.minimum(5.31 + 0.17 * np.arange(16) * SAMPLE / 1.0, 5.48)  # climbing back
-    uav = Body("uav1", "uav", route[0], np.array([0.0, 1.0]), (5.21, 5.41), RADII["uav"], 3)
+    uav = Body("uav1", "uav", route[0], np.array([0.0, 1.0]), (5.21, 5.41),
+               KIND_DEFAULTS["uav"].passes_by, 3)
     person = Body("human1", "human", np.array([65.1, 80.6]), np.zeros(2), (3.5, 5.25),
-                  RADII["human"], 10_000)
+                  KIND_DEFAULTS["human"].passes_by, 10_000)
     forward = np.array([0.0, 1.0])
     right = np.array([1.0, 0.0])
     args = (uav, [person], forward, right, 1.0, route)

@@ -56,7 +56,7 @@ def route(ctx: Context, robot: Robot,
     """Route from where the robot is to a floor-level goal, at the robot's sensor height."""
     now = robot.position(ctx.env.now)
     return ctx.navigator.route(robot, ctx.world.on_floor(now), np.asarray(goal_floor, dtype=float),
-                               at=now if robot.kind == "uav" else None)
+                               at=now if KIND_DEFAULTS[robot.kind].flies else None)
 
 
 def climb(ctx: Context, robot: Robot, height: float) -> StepGen:

@@ -19,6 +19,7 @@ from astralis_des.assignment import auction, cbba, milp  # noqa: F401  (they reg
 from astralis_des.assignment.eq1 import Weights, eq1_costs
 from astralis_des.assignment.plans import Plan, Problem
 from astralis_des.assignment.strategies import EXCLUDED, register_planner
+from astralis_des.kinds import KIND_DEFAULTS
 
 
 def _matching(costs: np.ndarray, allowed: np.ndarray) -> list[list[int]]:
@@ -40,11 +41,12 @@ def hard(problem: Problem) -> Plan:
     mess = np.array([r.messiness for r in problem.rooms])
     kinds = [a.kind for a in problem.agents]
     forbidden = np.zeros(problem.allowed.shape, dtype=bool)
+    # each kind kept out of the rooms high in its hazard (a person: risk; the UGV: messiness)
+    unsafe = {"risk": risk >= problem.high_risk, "messiness": mess >= problem.high_messiness}
     for i, kind in enumerate(kinds):
-        if kind == "human":
-            forbidden[i] = risk >= problem.high_risk
-        elif kind == "ugv":
-            forbidden[i] = mess >= problem.high_messiness
+        hazard = KIND_DEFAULTS[kind].hazard
+        if hazard is not None:
+            forbidden[i] = unsafe[hazard]
     allowed = problem.allowed & ~forbidden
     costs = eq1_costs(problem.agents, problem.rooms, Weights.zero())
     queues = _matching(costs, allowed)

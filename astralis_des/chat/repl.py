@@ -21,6 +21,7 @@ from astralis_des.chat.language import Parsed, complete, help_rows, parse
 from astralis_des.chat.show import events_text, queue_text, reply, unwrapped
 from astralis_des.chat.team import ChatError, Team
 from astralis_des.exits import EXIT_INTERRUPTED
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.registry import Registry
 
 if TYPE_CHECKING:
@@ -239,7 +240,8 @@ def _serve_here(args: argparse.Namespace, console: Console) -> tuple[Any, Path, 
     clock = "paused: step moves time" if args.stepped else f"running at {args.pace:g}x"
     console.print(Text(f"serving {mission.name} here at {address} (clock {clock}); outputs go "
                        f"to {out}/"), soft_wrap=True)  # one line each: a command to copy
-    walker = next((m.id for m in mission.spec.team if m.kind == "human"), mission.spec.team[0].id)
+    walker = next((m.id for m in mission.spec.team if KIND_DEFAULTS[m.kind].person),
+                  mission.spec.team[0].id)
     console.print(Text(f"drive a robot from another terminal: astralis teleop {walker} "
                        f"--connect {address}"), soft_wrap=True)
     return background, out, address

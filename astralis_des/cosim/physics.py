@@ -23,6 +23,7 @@ import simpy
 from astralis_des.detection import Sighting
 from astralis_des.kernel.contracts import CoSim, Host, MotionOutcome, Sensor
 from astralis_des.kernel.robot import Motion, Robot
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.physics.client import PhysicsClient
 from astralis_des.physics.drivers import DRIVERS, Driver, DriverClass, HumanDriver
 from astralis_des.physics.hexacopter import write_urdf
@@ -187,7 +188,7 @@ class PhysicsCoSim:
     # -- the co-simulation contract ------------------------------------------------------
     def execute(self, robot: Robot, motion: Motion) -> simpy.Event:
         self.halt(robot)
-        if robot.kind == "uav":
+        if KIND_DEFAULTS[robot.kind].flies:
             motion = self._clear_of_movers(robot, motion)
         motion.t0 = self.env.now
         self.drivers[robot.id].start(motion, self.env.now)
@@ -391,7 +392,7 @@ class PhysicsCoSim:
             body = self.drivers[rid].body
             for c in self.client.call("getContactPoints", bodyA=body):
                 other = self.names.get(c[2], "object")
-                if (robot.kind != "uav" or not robot.airborne) and other in FLOORS \
+                if (not KIND_DEFAULTS[robot.kind].flies or not robot.airborne) and other in FLOORS \
                         and c[7][2] > SUPPORT:
                     continue  # wheels or feet on a floor, a UAV taking off or landing
                 key = (rid, other)

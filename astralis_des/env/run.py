@@ -27,6 +27,7 @@ from astralis_des.env.layout import CONTINUE, HOLD, WAIT, Layout, searches_of
 from astralis_des.env.rewards import Progress
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import TaskStatus
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.mission.loader import Mission
 from astralis_des.simulation import Simulation
 from astralis_des.simulation.result import RunResult
@@ -279,10 +280,10 @@ class EpisodeRun:
                 continue
             if res.coverage is not None:
                 self.coverage[task.room] = max(self.coverage.get(task.room, 0.0), res.coverage)
-            kind = sim.robots[task.robot].kind
-            if kind == "human" and sim.rooms[task.room].risk >= cfg.high_risk:
+            hazard = KIND_DEFAULTS[sim.robots[task.robot].kind].hazard
+            if hazard == "risk" and sim.rooms[task.room].risk >= cfg.high_risk:
                 risk += res.end - res.start
-            if kind == "ugv" and sim.rooms[task.room].messiness >= cfg.high_messiness:
+            if hazard == "messiness" and sim.rooms[task.room].messiness >= cfg.high_messiness:
                 clutter += res.end - res.start
         now = sim.env.now
         dt, self._t = now - self._t, now

@@ -6,6 +6,7 @@ from typing import Any
 
 from pydantic import Field, model_validator
 
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.mission.types import Finite, NonNegativeFloat, PositiveFloat, Strict, Vec3
 
 
@@ -146,8 +147,11 @@ class SensorsSpec(Strict):
 
 SENSORS = ("camera", "lidar", "lidar3d", "imu", "gnss", "barometer", "magnetometer")
 POSE_SENSORS = ("gnss", "barometer", "magnetometer")  # read the pose alone: both fidelities
-# What each kind can carry: the human operator has eyes (a camera model) and nothing else.
-CARRIES: dict[str, tuple[str, ...]] = {
-    "uav": SENSORS, "ugv": SENSORS, "human": ("camera",),
-}
+
+
+def carries(kind: str) -> tuple[str, ...]:
+    """The sensors ``kind`` can carry (its record's, else every one)."""
+    return KIND_DEFAULTS[kind].carries or SENSORS
+
+
 _DEFAULT_SPECS = {"camera": CameraSpec(), "lidar": LidarSpec(), "imu": ImuSpec()}

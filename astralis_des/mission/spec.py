@@ -8,7 +8,6 @@ from pydantic import Field, field_validator, model_validator
 
 from astralis_des.mission.sensor_spec import (  # noqa: F401  (re-exported)
     _DEFAULT_SPECS,
-    CARRIES,
     POSE_SENSORS,
     SENSORS,
     BarometerSpec,
@@ -20,6 +19,7 @@ from astralis_des.mission.sensor_spec import (  # noqa: F401  (re-exported)
     MagnetometerSpec,
     SensorsSpec,
     SiteSpec,
+    carries,
 )
 from astralis_des.mission.types import (  # noqa: F401  (re-exported)
     MAX_SPEED,
@@ -54,9 +54,9 @@ class MemberSpec(Strict):
     def _can_carry(self) -> MemberSpec:
         for name in SENSORS:
             if self.sensors is not None and getattr(self.sensors, name) is not None \
-                    and name not in CARRIES[self.kind]:
+                    and name not in carries(self.kind):
                 raise ValueError(f"sensors.{name}: a {self.kind} cannot carry a {name}; it "
-                                 f"carries: {', '.join(CARRIES[self.kind])}")
+                                 f"carries: {', '.join(carries(self.kind))}")
         return self
 
     @property

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.physics.courses import closest_approach, on_route
 from astralis_des.physics.drivers import SAMPLE
 from astralis_des.world.geometry import FloatArray
@@ -19,8 +20,12 @@ if TYPE_CHECKING:
 CLIMB_MARGIN = 0.3  # m a climbing UAV keeps above a walker's head
 MAX_CLIMB = 0.8  # m: a UAV climbs at most this far above its course
 CLIMB_SOON = 3.0  # s: a walker this close to meeting a UAV makes it climb
-WALKERS = ("human", "avatar")
 MOVER_AHEAD = np.linspace(0.0, 3.0, 16)  # s ahead at which a mover's path is looked at
+
+
+def _walks(kind: str) -> bool:
+    """Whether a body of ``kind`` walks: a person of the team, or an avatar of the scene."""
+    return kind == "avatar" or (kind in KIND_DEFAULTS and KIND_DEFAULTS[kind].person)
 
 
 class Climber:
@@ -48,7 +53,7 @@ class Climber:
                                      len(path_ahead) - 1)]
         floor = me.base_z[0] if lowest is None else min(me.base_z[0], lowest)
         for other in others:
-            if other.kind not in WALKERS or other.z[1] < floor:
+            if not _walks(other.kind) or other.z[1] < floor:
                 continue
             clear = me.radius + other.radius + 0.3
             path = paths.get(other.name) if other.kind == "avatar" else None

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from astralis_des.kinds import KIND_DEFAULTS, KINDS
 from astralis_des.physics.client import PhysicsClient
 from astralis_des.world.geometry import FloatArray
 from astralis_des.world.model import World
@@ -85,8 +86,10 @@ class Lift:
 
 
 def lifts_of(world: World, client: PhysicsClient) -> list[Lift]:
-    """A lift in the shaft of each building whose stairs the UGV may use."""
+    """A lift in the shaft of each building whose stairs a kind that takes the lift (the
+    UGV) may use."""
     return [Lift(client, b.id, np.array(b.lift.lo[:2]) + GAP, np.array(b.lift.hi[:2]) - GAP,
                  z=float(b.footprint.lo[2]))
             for b in world.buildings.values()
-            if b.lift is not None and "ugv" in world.stairs_passable_by.get(b.id, ("ugv",))]
+            if b.lift is not None and any(KIND_DEFAULTS[k].floors == "lift"
+                                          for k in world.stairs_passable_by.get(b.id, KINDS))]

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.physics.climb import MOVER_AHEAD, Climber
 from astralis_des.physics.courses import Body, on_route
 from astralis_des.physics.drivers import SAMPLE
@@ -42,9 +43,6 @@ BRAKING = 1.0  # s: the stopping range grows by this times the robot's speed
 SHIFT = 0.7  # m to the right at most
 STOP_RANGE = 0.8  # m between bodies' edges ahead: hold
 LANE_MARGIN = 0.15  # m added to the two radii to decide "in my lane"
-HEIGHTS = {"uav": (-0.1, 0.1), "ugv": (-0.5, 0.15), "human": (-1.6, 0.15)}  # around the pose
-RADII = {"uav": 0.3, "ugv": 0.62, "human": 0.25}  # the UGV: its half-diagonal
-HALF_WIDTHS = {"ugv": 0.4}  # beside it: the Husky's half-width and a margin for its turning
 STILL_RANK = 10_000  # movers, the lift, and robots not moving: everyone yields to them
 NEAR = 6.0  # m: movers farther than this from every moving robot need not move in physics
 RATE = 5.0  # Hz: how often the layer decides (a UAV flies 0.3 m in between)
@@ -80,7 +78,8 @@ class LocalLayer:
         for rid, driver in self.cosim.drivers.items():
             robot = self.cosim.robots[rid]
             here = driver.position()
-            low, high = HEIGHTS[robot.kind]
+            kind = KIND_DEFAULTS[robot.kind]
+            low, high = kind.band
             active = rid in self.cosim.active
             velocity = driver.heading_vector() if active and not driver.held else np.zeros(2)
             # a robot that is not moving cannot yield: it ranks with the movers
@@ -88,9 +87,9 @@ class LocalLayer:
             course = driver.course_z() if active else None
             course = here[2] if course is None else course
             found.append(Body(rid, robot.kind, here[:2], velocity,
-                              (here[2] + low, here[2] + high), RADII[robot.kind], rank,
+                              (here[2] + low, here[2] + high), kind.passes_by, rank,
                               (course + low, course + high), driver.shift,
-                              HALF_WIDTHS.get(robot.kind, 0.0)))
+                              kind.half_width))
         for mover, _ in self.cosim.movers:
             here = mover.position_at(t)
             ahead = mover.position_at(t + 0.5)
@@ -146,7 +145,7 @@ class LocalLayer:
             here = me.xy[None, :]
             climb = self.climber.need(me, others, np.zeros(2), here, here,
                                       not self._by_doorway(me.xy, me.base_z[0]),
-                                      self._paths)[0] if me.kind == "uav" else 0.0
+                                      self._paths)[0] if KIND_DEFAULTS[me.kind].flies else 0.0
             driver.avoid(False, np.zeros(2), climb)
             return
         forward = direction / speed
@@ -154,7 +153,7 @@ class LocalLayer:
         route = ahead[:, :2] + me.offset
         if len(route) < 3:  # at the end of its path: the way it is headed
             route = me.xy + forward * np.arange(0.0, PATH_AHEAD, SAMPLE)[:, None]
-        heights = ahead[:, 2] if me.kind == "uav" and len(ahead) >= 3 else None
+        heights = ahead[:, 2] if KIND_DEFAULTS[me.kind].flies and len(ahead) >= 3 else None
         hold, shift, aside, blockers = self._decide(me, others, forward, right, speed, route,
                                                     heights)
         door = doors[rid]
@@ -173,7 +172,7 @@ class LocalLayer:
         open_space = door is None and not in_doorway
         climb, coming = self.climber.need(me, others, direction, route, ahead[:, :2] + me.offset,
                                           open_space, self._paths, _lowest(me, ahead)) \
-            if me.kind == "uav" else (0.0, [])
+            if KIND_DEFAULTS[me.kind].flies else (0.0, [])
         hold = hold or bool(coming)
         if shift.any() and open_space:
             shift = self._clear_shift(ahead, shift, (1.0,) if aside else SHARES)
@@ -211,7 +210,7 @@ class LocalLayer:
             reach, off_route = on_route(route, other.xy, other.velocity)
             if heights is not None and gap > 0.0:
                 there = float(heights[min(round(reach / SAMPLE), len(heights) - 1)])
-                if other.z[1] < there + HEIGHTS["uav"][0]:
+                if other.z[1] < there + KIND_DEFAULTS[me.kind].band[0]:
                     continue  # under its way where it gets there
             if along > 0 and off_route < lane + SHIFT:
                 if float(other.velocity @ forward) < -0.05:  # coming towards us: keep right
@@ -329,7 +328,7 @@ class LocalLayer:
     def _goal_taken(self, driver: Driver, me: Body, others: list[Body]) -> Body | None:
         """The body standing still on this robot's goal, if any."""
         goal = driver.goal_point()
-        low, high = HEIGHTS[me.kind]
+        low, high = KIND_DEFAULTS[me.kind].band
         for other in others:
             if float(np.linalg.norm(other.velocity)) > 0.05 or other.kind == "lift":
                 continue
@@ -344,7 +343,8 @@ def _lowest(me: Body, ahead: FloatArray) -> float:
     """The bottom of a UAV's band where its course comes lowest over its path ahead (the
     climb rule takes the lower of this and its band now): coming down from a lifted point
     (over furniture, or where it made way), it must not come down onto a walker."""
-    return float(ahead[:, 2].min()) + HEIGHTS["uav"][0] if len(ahead) else me.base_z[0]
+    return float(ahead[:, 2].min()) + KIND_DEFAULTS[me.kind].band[0] if len(ahead) \
+        else me.base_z[0]
 
 
 def _round(path: FloatArray, xy: FloatArray, clear: float) -> FloatArray | None:

@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from astralis_des.physics.local import DOOR_BUSY, RADII
+from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.physics.local import DOOR_BUSY
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
 if TYPE_CHECKING:
@@ -31,11 +32,11 @@ def aside(cosim: Engine, robot: Robot, here: FloatArray, path: FloatArray,
     rings = [here + np.column_stack([np.cos(angles), np.sin(angles), np.zeros(len(angles))]) * r
              for r in ASIDE_STEPS]
     spots = np.vstack(rings)
-    clear_of = RADII[robot.kind] + RADII[asker_kind] + 0.3
+    touching = KIND_DEFAULTS[robot.kind].passes_by + KIND_DEFAULTS[asker_kind].passes_by
+    clear_of = touching + 0.3
     gaps = np.linalg.norm(spots[:, None, :2] - path[None, :, :2], axis=2).min(axis=1)
     floor = cosim.world.floor_below(here - np.array([0.0, 0.0, robot.height]))
     near_door = cosim.world.near_doorway(spots, floor, DOOR_BUSY)
-    touching = RADII[robot.kind] + RADII[asker_kind]
     for index in np.flatnonzero((gaps >= clear_of) & ~near_door):
         spot = spots[index]
         leg = here + (spot - here) * np.linspace(0.0, 1.0, 6)[:, None]

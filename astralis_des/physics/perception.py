@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 
 from astralis_des.detection import predict_pixels
 from astralis_des.kernel.robot import Robot
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.mission.spec import CameraSpec, ImuSpec, Lidar3dSpec, LidarSpec
 from astralis_des.physics.lidar3d import Lidar3D
 from astralis_des.physics.sensors import Camera, Frame, Imu, ImuReading, Intrinsics, Lidar2D
@@ -47,7 +48,6 @@ AHEAD = math.radians(25.0)  # half-angle of the lidar sector a UGV slows down fo
 SLOW_AT = 1.5  # m from the lidar: nearer than this ahead, a UGV slows down ...
 STOP_AT = 0.7  # m: ... to CREEP of its speed here
 CREEP = 0.3
-LIDAR_OFFSET = {"ugv": 0.6, "uav": 0.5}  # m: rays start outside the body
 CULL = 0.5  # no frame is rendered when the target, unhidden (or hidden only by walls and
 # slabs), would show less than this share of the pixels a detection needs (the shared
 # detection model's prediction)
@@ -147,14 +147,14 @@ class Perception:
                 self.lidars[member.id] = (Lidar2D(
                     cosim.client, body, _mount(cosim, member.id), spec.beams, spec.range,
                     noise_std=spec.noise_std, rng=stream(seed, "sensing", 1, index),
-                    start_offset=LIDAR_OFFSET.get(member.kind, 0.5)), spec)
+                    start_offset=KIND_DEFAULTS[member.kind].lidar_offset), spec)
             if sensors.lidar3d is not None:
                 s3 = sensors.lidar3d
                 self.lidars3d[member.id] = (Lidar3D(
                     cosim.client, body, channels=s3.channels, vertical_fov=s3.vertical_fov,
                     resolution=s3.resolution, range_max=s3.range, noise_std=s3.noise_std,
                     rng=stream(seed, "sensing", 3, index),
-                    start_offset=LIDAR_OFFSET.get(member.kind, 0.5),
+                    start_offset=KIND_DEFAULTS[member.kind].lidar_offset,
                     mount=tuple(_mount(cosim, member.id))), s3)
             if sensors.imu is not None:
                 spec_i = sensors.imu

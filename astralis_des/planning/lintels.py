@@ -26,10 +26,10 @@ DUCK_LOWEST = 1.0  # m over the floor: it flies no lower to pass under one
 
 
 class Lintels:
-    """The navigator's lintel rules (a mixin: it needs ``world`` and ``_furniture``)."""
+    """The navigator's lintel rules (a mixin: it needs ``world`` and ``furniture``)."""
 
     world: World
-    _furniture: Callable[[FloatArray, FloatArray], FloatArray]  # still boxes near [lo, hi]
+    furniture: Callable[[FloatArray, FloatArray], FloatArray]  # still boxes near [lo, hi]
 
     def _ducked(self, robot: Robot, points: FloatArray, radius: float) -> FloatArray:
         """A UAV's route on the graph, flown under the lintels as the physics route is (the
@@ -60,7 +60,7 @@ class Lintels:
         near = solids[np.all((solids[:, 0] <= hi) & (solids[:, 1] >= lo), axis=1)]
         grown = [np.stack([near[:, 0] - radius, near[:, 1] + radius], axis=1)]
         if keep_out is not None:
-            things = self._furniture(lo, hi)
+            things = self.furniture(lo, hi)
             grown.append(np.stack([things[:, 0] - radius - keep_out,
                                    things[:, 1] + radius + keep_out], axis=1))
         boxes = np.concatenate(grown)

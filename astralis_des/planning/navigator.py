@@ -1,6 +1,7 @@
 """Routes for one simulation: the room graph finds the way (doors, corridors, stairwells), and
-in ``map`` mode every leg a straight line cannot take is planned around what stands in it:
-OMPL in 3-D for a UAV, OMPL in SE2 (Reeds-Shepp) for the UGV, A* on the floor for a walker.
+in ``map`` mode every leg a straight line cannot take is planned around what stands in it, by
+the planner the robot's kind names (:mod:`astralis_des.planning.planners`): OMPL in 3-D for a
+UAV, OMPL in SE2 (Reeds-Shepp) for the UGV, A* on the floor for a walker.
 
 ``graph`` mode (the kinematic default) keeps the graph's straight legs: thousands of missions
 a minute. ``map`` mode (the physics default) follows each room's real furniture.
@@ -11,16 +12,18 @@ from __future__ import annotations
 import itertools
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
 from astralis_des.errors import InputError
-from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.kinds import KIND_DEFAULTS, KindDefaults
 from astralis_des.memo import kept
-from astralis_des.planning.footprint import RIM, facing, fits_turned, rectangle_free
+from astralis_des.planning.footprint import RIM, fits_turned
 from astralis_des.planning.lintels import Lintels
+from astralis_des.planning.planners import PLANNERS, Leg, Planned
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 
 if TYPE_CHECKING:
@@ -29,10 +32,6 @@ if TYPE_CHECKING:
     from astralis_des.world.model import World
     from astralis_des.world.scene import Scene
 
-BODY_RADIUS = {k: d.radius for k, d in KIND_DEFAULTS.items()}  # m, a disc round its centre
-# m more kept from furniture and people than from walls: a UAV cuts a corner of its path by
-# up to a quarter metre (measured), and it should not brush a person's head
-KEEP_OUT = {"uav": 0.2, "ugv": 0.0, "human": 0.0}
 WINDOW = 3.0  # m around a leg that its planner may use
 NUDGE = 0.6  # m: how far a leg's end in collision may be moved to a free point
 CELL = 0.1  # m, walkers' floor grid
@@ -84,8 +83,8 @@ class Navigator(Lintels):
                 from astralis_des.planning.blocks import round_blocks
 
                 rounded, reason = round_blocks(
-                    self.world, points, BODY_RADIUS[robot.kind] + self.cfg.margin,
-                    fly=robot.kind == "uav", floor=float(start[2]))
+                    self.world, points, _kind(robot).radius + self.cfg.margin,
+                    fly=_kind(robot).flies, floor=float(start[2]))
                 if rounded is None:
                     return Route(None, reason)
                 points = rounded
@@ -94,8 +93,8 @@ class Navigator(Lintels):
                 first = level_legs(np.vstack([at, points[1:2]]))
                 points = np.vstack([first[:-1] if len(points) > 1 else first, points[1:]])
             if self.method == "graph":
-                return Route(self._ducked(robot, points, BODY_RADIUS[robot.kind] +
-                                          self.cfg.margin) if robot.kind == "uav" else points)
+                return Route(self._ducked(robot, points, _kind(robot).radius +
+                                          self.cfg.margin) if _kind(robot).flies else points)
             return self.refine(robot, points)
         finally:
             self.seconds += time.perf_counter() - t0
@@ -104,8 +103,8 @@ class Navigator(Lintels):
         """Replace each leg a straight line cannot take by a planned detour. With ``skip``
         (a coverage path) a point no detour reaches is left out and counted, and the path
         goes on to the next one; else the route fails there."""
-        radius = BODY_RADIUS[robot.kind] + self.cfg.margin
-        if robot.kind == "uav":
+        radius = _kind(robot).radius + self.cfg.margin
+        if _kind(robot).flies:
             points = self._under_lintels(robot, points, radius)
         out = [points[0]]
         skipped = 0
@@ -115,8 +114,8 @@ class Navigator(Lintels):
                 out.append(b)
                 continue
             ducked = self._duck(robot, a, b, self._free(np.array([a, b]), radius,
-                                                         KEEP_OUT[robot.kind])) \
-                if robot.kind == "uav" else None
+                                                         _kind(robot).keep_out)) \
+                if _kind(robot).flies else None
             if ducked is not None:
                 out.extend(ducked[1:])
                 continue
@@ -139,7 +138,7 @@ class Navigator(Lintels):
         ceiling leaves room, else dropped; the map (``map`` mode only: on the graph none is
         built) checks the walls. :func:`level_legs` then makes its legs climb and come down
         clear of what it flies over."""
-        if robot.kind == "uav":
+        if _kind(robot).flies:
             points, ok = self._over_furniture(robot, np.atleast_2d(points))
             if self.method == "map":
                 ok &= self.fits(robot, points)
@@ -149,11 +148,11 @@ class Navigator(Lintels):
 
     def _over_furniture(self, robot: Robot, points: FloatArray) -> tuple[FloatArray, np.ndarray]:
         """``points`` each raised above the still furniture and people it would touch (boxes
-        grown by the body, its margin and ``KEEP_OUT``), and where the raised point keeps
+        grown by the body, its margin and its kind's ``keep_out``), and where the raised point keeps
         that clearance below its room's ceiling."""
         pts = np.array(points, dtype=float)
-        clear = BODY_RADIUS[robot.kind] + self.cfg.margin + KEEP_OUT[robot.kind]
-        boxes = self._furniture(pts.min(axis=0) - clear, pts.max(axis=0) + clear)
+        clear = _kind(robot).radius + self.cfg.margin + _kind(robot).keep_out
+        boxes = self.furniture(pts.min(axis=0) - clear, pts.max(axis=0) + clear)
         ok = np.ones(len(pts), dtype=bool)
         if not len(boxes):
             return pts, ok
@@ -175,8 +174,8 @@ class Navigator(Lintels):
         planner uses: a UAV's in the voxel map with the furniture, a walker's and the UGV's
         on the grid of their floor's slice."""
         pts = np.atleast_2d(np.asarray(points, dtype=float))
-        radius = BODY_RADIUS[robot.kind] + self.cfg.margin
-        if robot.kind == "uav":
+        radius = _kind(robot).radius + self.cfg.margin
+        if _kind(robot).flies:
             return np.asarray(self._valid(robot, pts, radius))
         ok = np.zeros(len(pts), dtype=bool)
         floors = np.array([self.world.floor_below(p - np.array([0.0, 0.0, robot.height]))
@@ -185,7 +184,7 @@ class Navigator(Lintels):
             mine = floors == floor
             lo = pts[mine, :2].min(axis=0) - radius - 2 * CELL
             hi = pts[mine, :2].max(axis=0) + radius + 2 * CELL
-            ok[mine] = self._floor_grid(lo, hi, float(floor)).free(pts[mine, :2], radius)
+            ok[mine] = self.floor_grid(lo, hi, float(floor)).free(pts[mine, :2], radius)
         return ok
 
     def stands(self, robot: Robot, points: FloatArray) -> np.ndarray:
@@ -194,22 +193,22 @@ class Navigator(Lintels):
         or a goal."""
         pts = np.atleast_2d(np.asarray(points, dtype=float))
         ok = self.fits(robot, pts)
-        footprint = KIND_DEFAULTS[robot.kind].footprint
+        footprint = _kind(robot).footprint
         if footprint is None or not ok.any():
             return ok
-        reach = (KIND_DEFAULTS[robot.kind].swept_radius or 0.0) + self._rim_clearance + 2 * CELL
+        reach = (_kind(robot).swept_radius or 0.0) + self.rim_clearance + 2 * CELL
         at = np.flatnonzero(ok)
         floors = np.array([self.world.floor_below(p - np.array([0.0, 0.0, robot.height]))
                            for p in pts[at]])
         for floor in np.unique(floors):  # one grid a floor (it is on the world's lattice)
             mine = at[floors == floor]
-            grid = self._floor_grid(pts[mine, :2].min(axis=0) - reach,
+            grid = self.floor_grid(pts[mine, :2].min(axis=0) - reach,
                                     pts[mine, :2].max(axis=0) + reach, float(floor))
-            ok[mine] = fits_turned(grid, pts[mine], footprint, self._rim_clearance)
+            ok[mine] = fits_turned(grid, pts[mine], footprint, self.rim_clearance)
         return ok
 
     @property
-    def _rim_clearance(self) -> float:
+    def rim_clearance(self) -> float:
         """What a long body's rim keeps from what stands on the floor (the grid's cells are
         checked at the rim's points, ``RIM`` apart)."""
         return self.cfg.margin + RIM / 2
@@ -241,7 +240,7 @@ class Navigator(Lintels):
             self._map = world_map(self.world)
         return self._map
 
-    def _furniture(self, lo: FloatArray, hi: FloatArray) -> FloatArray:
+    def furniture(self, lo: FloatArray, hi: FloatArray) -> FloatArray:
         """Boxes of still furniture and avatars in the rooms overlapping ``[lo, hi]``."""
         rooms = [rid for rid, room in self.world.rooms.items()
                  if np.all(np.asarray(room.box.lo) <= hi) and
@@ -250,12 +249,12 @@ class Navigator(Lintels):
 
     def _valid(self, robot: Robot, points: FloatArray, radius: float) -> np.ndarray:
         pts = np.atleast_2d(points)
-        reach = radius + KEEP_OUT[robot.kind]
-        boxes = self._furniture(pts.min(axis=0) - reach, pts.max(axis=0) + reach)
-        return self._checker(boxes, radius, KEEP_OUT[robot.kind])(pts)
+        reach = radius + _kind(robot).keep_out
+        boxes = self.furniture(pts.min(axis=0) - reach, pts.max(axis=0) + reach)
+        return self.checker(boxes, radius, _kind(robot).keep_out)(pts)
 
-    def _checker(self, boxes: FloatArray, radius: float,  # type: ignore[no-untyped-def]
-                 keep_out: float = 0.0):
+    def checker(self, boxes: FloatArray, radius: float,
+                keep_out: float = 0.0) -> Callable[[FloatArray], np.ndarray]:
         """A validity test for many states: the map's clearance, and the furniture ``boxes``
         grown by ``radius`` and ``keep_out`` (gathered once, not per state: a planner asks
         thousands)."""
@@ -279,11 +278,11 @@ class Navigator(Lintels):
         without ``furniture``)? Boxes, not the map: most legs are clear, and the map is then
         never needed (it is built for planning only)."""
         a, b = a.copy(), b.copy()
-        if robot.kind != "uav":  # a ground body stands on its floor: test at its middle
+        if not _kind(robot).flies:  # a ground body stands on its floor: test at its middle
             a[2] = b[2] = self.world.floor_below(a) + 0.4
-        keep_out = KEEP_OUT[robot.kind]
+        keep_out = _kind(robot).keep_out
         lo, hi = np.minimum(a, b) - radius - keep_out, np.maximum(a, b) + radius + keep_out
-        things = self._furniture(lo, hi) if furniture else np.zeros((0, 2, 3))
+        things = self.furniture(lo, hi) if furniture else np.zeros((0, 2, 3))
         margins = np.concatenate([np.full(len(self.world.solid_array), radius),
                                   np.full(len(things), radius + keep_out)])
         boxes = np.concatenate([self.world.solid_array, things])
@@ -322,56 +321,15 @@ class Navigator(Lintels):
         return None
 
     def _plan_free_leg(self, robot: Robot, a: FloatArray, b: FloatArray,
-                       radius: float) -> tuple[FloatArray | None, str]:
+                       radius: float) -> Planned:
+        """A detour by the planner the robot's kind names, within ``WINDOW`` of the leg."""
         self.plans += 1
         seed = (self.seed * 1_000_003 + next(self._counter)) % (2**31)
-        lo = np.minimum(a, b) - WINDOW
-        hi = np.maximum(a, b) + WINDOW
-        budget = self.cfg.budget
-        if robot.kind == "uav":
-            from astralis_des.planning.ompl_adapter import plan_3d
+        kind = _kind(robot)
+        leg = Leg(kind, a, b, radius, np.minimum(a, b) - WINDOW, np.maximum(a, b) + WINDOW, seed)
+        return PLANNERS.get(kind.planner)(self, leg)
 
-            lo[2], hi[2] = min(a[2], b[2]) - 1.0, max(a[2], b[2]) + 1.0
-            valid = self._checker(self._furniture(lo - KEEP_OUT["uav"], hi + KEEP_OUT["uav"]),
-                                  radius, KEEP_OUT["uav"])
-            plan = plan_3d(valid, lo, hi, a, b,
-                           budget=budget, planner=self.cfg.uav_planner, seed=seed,
-                           resolution=0.1)
-            return (plan.path if plan.ok else None), plan.reason
-        floor = self.world.floor_below(a)
-        grid = self._floor_grid(lo[:2], hi[:2], floor)
-        if robot.kind == "ugv":
-            from astralis_des.planning.ompl_adapter import plan_se2
-
-            heading = math.atan2(b[1] - a[1], b[0] - a[0])
-            start = np.array([a[0], a[1], heading])
-            goal = np.array([b[0], b[1], heading])
-            footprint = KIND_DEFAULTS["ugv"].footprint
-            if footprint is not None:  # the body's rectangle at each state's heading
-                clearance = self._rim_clearance
-
-                def valid(states: FloatArray) -> np.ndarray:
-                    return rectangle_free(grid, states, footprint, clearance)
-            else:
-                def valid(states: FloatArray) -> np.ndarray:
-                    return np.asarray(grid.free(states[:, :2], radius))
-            start, goal = facing(valid, start), facing(valid, goal)
-            plan = plan_se2(valid, lo[:2], hi[:2], start, goal,
-                            turning_radius=self.cfg.turning_radius, budget=budget,
-                            space=self.cfg.ugv_space, seed=seed, resolution=0.05)
-            if not plan.ok or plan.path is None:
-                return None, plan.reason
-            xy = plan.path[:, :2]
-        else:
-            from astralis_des.planning.grid import plan_grid
-
-            found, reason = plan_grid(grid, a, b, radius, budget=budget)
-            if found is None:
-                return None, reason
-            xy = found
-        return np.column_stack([xy, np.full(len(xy), a[2])]), ""
-
-    def _floor_grid(self, lo: FloatArray, hi: FloatArray, floor: float) -> GridMap:
+    def floor_grid(self, lo: FloatArray, hi: FloatArray, floor: float) -> GridMap:
         """What stands on the floor (walls, furniture, avatars) between ``lo`` and ``hi``. The
         grid is aligned to one lattice of ``CELL`` for the whole world, so that a point is in
         the same cell, free or not, whichever window it is looked at in."""
@@ -384,7 +342,7 @@ class Navigator(Lintels):
         occupied = np.zeros(len(centers), dtype=bool)
         z_lo, z_hi = floor + 0.05, floor + 1.8
         solids = self.world.solid_array
-        boxes = np.concatenate([solids, self._furniture(np.array([*lo, z_lo]),
+        boxes = np.concatenate([solids, self.furniture(np.array([*lo, z_lo]),
                                                         np.array([*hi, z_hi]))])
         tall = (boxes[:, 0, 2] < z_hi) & (boxes[:, 1, 2] > z_lo) & \
             np.all((boxes[:, 0, :2] <= hi + CELL) & (boxes[:, 1, :2] >= lo - CELL), axis=1)
@@ -392,6 +350,11 @@ class Navigator(Lintels):
             occupied |= np.all((centers >= box[0, :2] - CELL / 2) &
                                (centers <= box[1, :2] + CELL / 2), axis=1)
         return GridMap.from_occupancy(occupied.reshape(tuple(shape)), lo, CELL)
+
+
+def _kind(robot: Robot) -> KindDefaults:
+    """The record of the robot's kind: what its body is and how it plans."""
+    return KIND_DEFAULTS[robot.kind]
 
 
 def level_legs(points: FloatArray) -> FloatArray:

@@ -1,18 +1,19 @@
 """How a recording draws things: where in the world each box belongs (building and storey),
 one colour per robot, robots as shapes turned to their heading, avatars in their Table II
-colour."""
+colour. How a kind is drawn is its record's ``look``, an entry of ``LOOKS``."""
 
 from __future__ import annotations
 
 import math
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 
 from astralis_des.kernel.robot import Robot
-from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.kinds import KIND_DEFAULTS, KindDefaults
+from astralis_des.registry import Registry
 from astralis_des.sinks import paths
 from astralis_des.world.geometry import Box
 from astralis_des.world.model import World
@@ -81,10 +82,18 @@ def log_body(rr: Any, rec: Any, robot: Robot, color: tuple[int, int, int, int]) 
     rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE, duration=np.array(
         robot.trail_t, dtype=float))], columns=rr.Transform3D.columns(translation=pts,
                                                                        quaternion=quats))
-    SHAPES[robot.kind](rr, rec, entity, color)
+    kind = KIND_DEFAULTS[robot.kind]
+    LOOKS.get(kind.look)(rr, rec, entity, color, kind)
 
 
-def _uav(rr: Any, rec: Any, entity: str, color: tuple[int, int, int, int]) -> None:
+Color = tuple[int, int, int, int]
+# look -> draw(rr, recording, entity, colour, the kind's record): a robot's body, logged once
+LOOKS: Registry[str, Callable[[Any, Any, str, Color, KindDefaults], None]] = Registry("look")
+
+
+@LOOKS.register("rotorcraft")
+def _rotorcraft(rr: Any, rec: Any, entity: str, color: Color, kind: KindDefaults) -> None:
+    """Its arms out to the rotors and a nose along its heading."""
     angles = np.arange(UAV_ARMS) * (2 * math.pi / UAV_ARMS) + math.pi / UAV_ARMS
     tips = np.column_stack([UAV_ARM * np.cos(angles), UAV_ARM * np.sin(angles),
                             np.zeros(UAV_ARMS)])
@@ -95,8 +104,10 @@ def _uav(rr: Any, rec: Any, entity: str, color: tuple[int, int, int, int]) -> No
     rec.log(entity + "/rotors", rr.Points3D(tips, colors=[color], radii=0.08), static=True)
 
 
-def _ugv(rr: Any, rec: Any, entity: str, color: tuple[int, int, int, int]) -> None:
-    length, width = KIND_DEFAULTS["ugv"].footprint or (1.0, 0.7)
+@LOOKS.register("rover")
+def _rover(rr: Any, rec: Any, entity: str, color: Color, kind: KindDefaults) -> None:
+    """A solid hull of its footprint (or its disc's square) and an arrow out of its front."""
+    length, width = kind.footprint or (kind.length, kind.length)
     rec.log(entity + "/hull", rr.Boxes3D(half_sizes=[(length / 2, width / 2, 0.2)],
                                          centers=[(0.0, 0.0, -0.2)], colors=[color],
                                          fill_mode="solid"), static=True)
@@ -105,13 +116,13 @@ def _ugv(rr: Any, rec: Any, entity: str, color: tuple[int, int, int, int]) -> No
                                            colors=[(255, 255, 255, 255)]), static=True)
 
 
-def _human(rr: Any, rec: Any, entity: str, color: tuple[int, int, int, int]) -> None:
+@LOOKS.register("person")
+def _person(rr: Any, rec: Any, entity: str, color: Color, kind: KindDefaults) -> None:
+    """A standing person's box, its top a little over its eyes."""
     rec.log(entity + "/person", rr.Boxes3D(half_sizes=[HUMAN_HALF], centers=[
-        (0.0, 0.0, HUMAN_HALF[2] - KIND_DEFAULTS["human"].height)], colors=[color],
+        (0.0, 0.0, HUMAN_HALF[2] - kind.height)], colors=[color],
         fill_mode="solid"), static=True)
 
-
-SHAPES = {"uav": _uav, "ugv": _ugv, "human": _human}
 
 
 def by_height(z: np.ndarray, top: float = 12.0) -> np.ndarray:

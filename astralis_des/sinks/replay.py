@@ -11,13 +11,13 @@ from typing import Any
 import numpy as np
 
 from astralis_des.kernel.events import Record
+from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.sinks import paths
 
 IDLE, MOVING, FAILED, FAULTED = "idle", "moving", "failed", "faulted"
 LANE_COLORS = {IDLE: (150, 150, 150), MOVING: (70, 150, 255), FAILED: (230, 60, 60),
                FAULTED: (130, 0, 0)}
 SEARCH_COLOR = (60, 200, 90)
-KIND_COLORS = {"uav": (30, 144, 255), "ugv": (255, 165, 0), "human": (220, 20, 60)}
 
 
 @dataclass
@@ -78,7 +78,7 @@ def log_rounds(rr: Any, rec: Any, rounds: Sequence[Mapping[str, Any]],
             ids.append(agent)
             positions.append((0.0, 100.0 * i))
             labels.append(f"{agent} ({kinds.get(agent, '?')})")
-            colors.append(KIND_COLORS.get(kinds.get(agent, ""), (200, 200, 200)))
+            colors.append(_color(kinds.get(agent)))
             radii.append(12.0)
         for j, room in enumerate(rooms):
             ids.append(room)
@@ -147,10 +147,11 @@ def metrics(records: Sequence[Record], rounds: Sequence[Mapping[str, Any]],
             add("coverage", t, float(record["coverage"]))
         risk, mess = latest.get(record.get("room") or "", (0.0, 0.0))
         spent = t - started.get(record["task"], t)
-        if kinds.get(robot) == "human" and risk >= high_risk:
+        hazard = _hazard(kinds.get(robot))
+        if hazard == "risk" and risk >= high_risk:
             exposure["human_in_high_risk_s"] += spent
             add("human_in_high_risk_s", t, exposure["human_in_high_risk_s"])
-        if kinds.get(robot) == "ugv" and mess >= high_messiness:
+        if hazard == "messiness" and mess >= high_messiness:
             exposure["ugv_in_high_messiness_s"] += spent
             add("ugv_in_high_messiness_s", t, exposure["ugv_in_high_messiness_s"])
     return series
@@ -168,3 +169,15 @@ def log_metrics(rr: Any, rec: Any, series: Series,
         color = (colors or {}).get(robot or "")
         rec.log(entity, style(names=[name.replace("_", " ")], colors=[color])
                 if color is not None else style(names=[name.replace("_", " ")]), static=True)
+
+
+def _hazard(kind: str | None) -> str | None:
+    """What makes a room unsafe for ``kind`` (None for a kind the run did not name)."""
+    record = KIND_DEFAULTS.get(kind or "")
+    return record.hazard if record is not None else None
+
+
+def _color(kind: str | None) -> tuple[int, int, int]:
+    """The colour of ``kind``'s node in the round graph (grey for a kind the run did not name)."""
+    record = KIND_DEFAULTS.get(kind or "")
+    return record.color if record is not None else (200, 200, 200)

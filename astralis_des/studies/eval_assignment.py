@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from astralis_des.assignment import Agent, RoomInfo, Weights, assign
+from astralis_des.kinds import KIND_DEFAULTS, KINDS
 from astralis_des.streams import stream
 from astralis_des.studies.evaluation import Metric, evaluation
 from astralis_des.studies.teams import team_ids
@@ -21,8 +22,8 @@ if TYPE_CHECKING:
 METRICS = (
     Metric("human_high_risk", "human -> high-risk room", "rate"),
     Metric("ugv_high_mess", "UGV -> high-messiness room", "rate"),
-    *(Metric(f"{kind}_unassigned", f"{kind.upper() if kind != 'human' else kind} unassigned",
-             "rate") for kind in ("human", "uav", "ugv")),
+    *(Metric(f"{kind}_unassigned", f"{KIND_DEFAULTS[kind].label or kind} unassigned", "rate")
+      for kind in sorted(KINDS)),
 )
 
 
@@ -48,11 +49,12 @@ def evaluate_assignment(study: Study, scenario: Scenario, variant: Variant,
     for j, room in enumerate(rooms, 1):
         row[f"risk_{j}"] = room.risk
         row[f"messiness_{j}"] = room.messiness
-    row["human_high_risk"] = any(kind_of[p.agent] == "human" and p.room in high_risk
+    hazard = {a.id: KIND_DEFAULTS[a.kind].hazard for a in agents}
+    row["human_high_risk"] = any(hazard[p.agent] == "risk" and p.room in high_risk
                                  for p in plan.pairs)
-    row["ugv_high_mess"] = any(kind_of[p.agent] == "ugv" and p.room in high_mess
+    row["ugv_high_mess"] = any(hazard[p.agent] == "messiness" and p.room in high_mess
                                for p in plan.pairs)
-    for kind in ("human", "uav", "ugv"):
+    for kind in sorted(KINDS):
         row[f"{kind}_unassigned"] = any(kind_of[a] == kind for a in plan.unassigned)
     row["total_cost"] = plan.total_cost
     row["assignment"] = " ".join(f"{p.agent}>{p.room}" for p in plan.pairs)

@@ -24,6 +24,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from astralis_des.kinds import KIND_DEFAULTS
+
 if TYPE_CHECKING:
     from astralis_des.simulation import Simulation
     from astralis_des.simulation.result import RunResult
@@ -65,19 +67,19 @@ def gini(values: np.ndarray) -> float:
 
 def _round_shares(sim: Simulation, rounds: list[dict[str, Any]], high_risk: float,
                   high_messiness: float) -> tuple[float | None, float | None]:
-    """Shares of the rounds with a person in a high-risk room, a UGV in a high-messiness one
-    (None where the team has no such agent or there were no rounds)."""
-    kinds = {rid: r.kind for rid, r in sim.robots.items()}
+    """Shares of the rounds with an agent in a room high in its hazard: a person in a
+    high-risk room, a UGV in a high-messiness one (None where the team has no agent with that
+    hazard or there were no rounds)."""
+    hazard = {rid: KIND_DEFAULTS[r.kind].hazard for rid, r in sim.robots.items()}
     shares: list[float | None] = []
-    for kind, column, threshold in (("human", "risk", high_risk),
-                                    ("ugv", "messiness", high_messiness)):
-        if kind not in kinds.values() or not rounds:
+    for column, threshold in (("risk", high_risk), ("messiness", high_messiness)):
+        if column not in hazard.values() or not rounds:
             shares.append(None)
             continue
         bad = 0
         for record in rounds:
             value = dict(zip(record["rooms"], record[column], strict=True))
-            bad += any(kinds.get(p["agent"]) == kind and value[p["room"]] >= threshold
+            bad += any(hazard.get(p["agent"]) == column and value[p["room"]] >= threshold
                        for p in record["matching"])
         shares.append(bad / len(rounds))
     return shares[0], shares[1]
@@ -85,8 +87,8 @@ def _round_shares(sim: Simulation, rounds: list[dict[str, Any]], high_risk: floa
 
 def social(sim: Simulation, end: float) -> dict[str, float | None]:
     """The closest approach of a moving robot to a person, and seconds within ``CLOSE``."""
-    people = [rid for rid, r in sim.robots.items() if r.kind == "human"]
-    others = [rid for rid, r in sim.robots.items() if r.kind != "human"]
+    people = [rid for rid, r in sim.robots.items() if KIND_DEFAULTS[r.kind].person]
+    others = [rid for rid, r in sim.robots.items() if not KIND_DEFAULTS[r.kind].person]
     if not people or not others or end <= 0:
         return {"human_min_distance": None, "human_close_s": None}
     times = np.arange(0.0, end + STEP / 2, STEP)

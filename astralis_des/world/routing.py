@@ -19,10 +19,10 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from astralis_des.errors import InputError
+from astralis_des.kinds import KIND_DEFAULTS, KINDS, KindDefaults
 from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
 from astralis_des.world.parts import BLOCK, Building, Room, Solid, Space
 
-KINDS = ("uav", "ugv", "human")
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
 STAIR_RUN_FACTOR = 2.0  # horizontal run of a flight of stairs per metre of rise
 UAV_WELL = 1.5  # m from the stairwell's far wall: where UAVs rise and sink between floors
@@ -164,19 +164,21 @@ class Router:
                 if previous is not None:  # a UGV takes the lift where there is one
                     self._stairs(previous, node, (yc - run) if south else
                                  min(yc + run, stair.hi[1] - 0.5), tuple(
-                        k for k in passable if k != "uav" and (k != "ugv" or b.lift is None)))
-                if "ugv" in passable and b.lift is not None:  # onto the lift's platform
+                        k for k in passable if _by_stairs(KIND_DEFAULTS[k], b)))
+                lifted = tuple(k for k in passable if KIND_DEFAULTS[k].floors == "lift")
+                if lifted and b.lift is not None:  # onto the lift's platform
                     lift = self._node(f"{b.id}.{floor}.lift", (*b.lift.center[:2], z))
-                    self._edge(node, lift, ("ugv",))
+                    self._edge(node, lift, lifted)
                     if floor > 1:
-                        self._edge(self.index[f"{b.id}.{floor - 1}.lift"], lift, ("ugv",))
-                if "uav" in passable:
+                        self._edge(self.index[f"{b.id}.{floor - 1}.lift"], lift, lifted)
+                flown = tuple(k for k in passable if KIND_DEFAULTS[k].floors == "well")
+                if flown:
                     wx = sx if south or b.lift is None else b.lift.center[0]
                     well = self._node(f"{b.id}.{floor}.well",
                                       (wx, max(stair.hi[1] - UAV_WELL, yc), z))
-                    self._edge(node, well, ("uav",))
+                    self._edge(node, well, flown)
                     if floor > 1:
-                        self._edge(self.index[f"{b.id}.{floor - 1}.well"], well, ("uav",))
+                        self._edge(self.index[f"{b.id}.{floor - 1}.well"], well, flown)
                 previous = node
             outside = self._node(f"{b.id}:entrance", b.entrance)
             self._edge(outside, self.corridor_nodes[f"{b.id}.1.corridor"][-1])
@@ -320,3 +322,8 @@ class Router:
         while nodes[-1] != a[i]:
             nodes.append(int(pred[i][nodes[-1]]))
         return np.vstack([p, self.positions[nodes[::-1]], q])
+
+
+def _by_stairs(kind: KindDefaults, building: Building) -> bool:
+    """Whether the kind takes the stairs of ``building`` (a lift-taker where it has none)."""
+    return kind.floors == "stairs" or (kind.floors == "lift" and building.lift is None)
