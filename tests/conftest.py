@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -11,6 +12,13 @@ import pytest
 from astralis_des import Mission, load_mission
 from astralis_des.world.build import load_world
 from astralis_des.world.model import World
+
+# The Ctrl-C tests send SIGINT to the commands they start, as a terminal does. A suite started
+# in the background of a non-interactive shell (a CI runner's `cmd &`) inherits SIGINT ignored,
+# and so would every command it starts; a terminal's foreground job has it at its default. So
+# the suite takes it back: a handler here is reset to the default in each command started.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 if TYPE_CHECKING:
     from astralis_des.api.client import Client
