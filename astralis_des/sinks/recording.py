@@ -3,7 +3,6 @@ trails, each robot's task and the events as text, on one ``sim_time`` timeline."
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Generator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -16,7 +15,7 @@ from astralis_des.sinks import paths
 from astralis_des.sinks.blueprint import blueprint
 from astralis_des.sinks.looks import TABLE_II_COLORS, by_height, by_place, log_body, robot_colors
 from astralis_des.sinks.replay import log_lanes, log_metrics, log_rounds, metrics, task_lanes
-from astralis_des.sinks.rrd_check import check_recording
+from astralis_des.sinks.rrd_check import close_and_check
 from astralis_des.sinks.sensor_log import log_detections, log_pose_sensors, log_sensors
 from astralis_des.world.clutter import Placed
 from astralis_des.world.model import BLOCK, World
@@ -25,7 +24,6 @@ if TYPE_CHECKING:
     from astralis_des.simulation import Simulation
     from astralis_des.simulation.result import RunResult
 
-log = logging.getLogger(__name__)
 SOLID_COLORS = {"wall": (170, 170, 180, 255), "slab": (120, 120, 130, 60)}
 OBSTACLE_COLOR = (60, 140, 60, 255)
 FURNITURE_COLORS = {"chair": (139, 90, 43, 255), "cabinet": (110, 110, 90, 255),
@@ -158,19 +156,7 @@ class RerunRecorder:
                 rec.log(paths.robot_plan(rid), rr.LineStrips3D.from_fields(
                     colors=[(*color[:3], 140)], radii=0.03), static=True)
         self._log_replay(result, perception)
-        self._end()
-
-    def _end(self) -> None:
-        """Flush and close the file, then read it back: Rerun's file sink only logs a failed
-        write (a full disk), so a recording that is not whole is an ``OSError`` here."""
-        suspect = False
-        try:
-            self.rec.flush()
-        except RuntimeError as exc:  # its writer thread stopped: the file is checked below
-            log.debug("%s: %s", self.path, exc)
-            suspect = True
-        self.rec.disconnect()
-        check_recording(self.path, suspect=suspect)
+        close_and_check(rec, self.path)  # Rerun's file sink only logs a failed write
 
     def discard(self) -> None:
         """The run's outputs are abandoned: stop writing (what it wrote is removed)."""

@@ -10,6 +10,7 @@ import logging
 import os
 import subprocess
 from pathlib import Path
+from typing import Any
 
 log = logging.getLogger(__name__)
 VERIFY_TIMEOUT = 600.0  # s: reading back a recording of several GB
@@ -23,6 +24,19 @@ def rerun_binary() -> Path | None:
         return None
     found = Path(rerun_cli.__file__).with_name("rerun")
     return found if found.is_file() else None
+
+
+def close_and_check(rec: Any, path: Path) -> None:
+    """Flush and close the recording stream ``rec`` saving to ``path``, then read the file
+    back: a recording that is not whole is an ``OSError`` here."""
+    suspect = False
+    try:
+        rec.flush()
+    except RuntimeError as exc:  # its writer thread stopped: the file is checked below
+        log.debug("%s: %s", path, exc)
+        suspect = True
+    rec.disconnect()
+    check_recording(path, suspect=suspect)
 
 
 def check_recording(path: Path, *, suspect: bool = False) -> None:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -12,7 +11,7 @@ from typing import Any
 from astralis_des.errors import InputError
 from astralis_des.mission.draws import RoomState
 from astralis_des.outdir import Staging
-from astralis_des.sinks.rrd_check import check_recording
+from astralis_des.sinks.rrd_check import close_and_check
 from astralis_des.world.build import load_world
 from astralis_des.world.catalogue import default_catalogue, load_catalogue
 from astralis_des.world.model import World
@@ -51,10 +50,7 @@ def show_world(world_file: str | Path, messiness: Sequence[float], out: str | Pa
         log_solids(rr, rec, world)
         log_rooms(rr, rec, world, {rid: RoomState(0.0, values[rid], "minimal") for rid in ids})
         log_furniture(rr, rec, placed, world)
-        with contextlib.suppress(RuntimeError):  # a write failed: the read-back says why
-            rec.flush()
-        rec.disconnect()
-        check_recording(folder / out.name)
+        close_and_check(rec, folder / out.name)
     return Shown(out, len(ids), Counter(p.kind for p in placed), scene.skipped())
 
 
