@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import importlib
 import json
 import logging
 import os
@@ -182,8 +181,6 @@ def _main(argv: Sequence[str] | None) -> int:
 
     try:
         with _quiet(args.quiet, own_process=argv is None):
-            if args.command in SIMULATING:
-                _import_silently("pybullet")  # it prints its build time on stderr as it loads
             return COMMANDS[args.command](args)
     except BrokenPipeError:  # the reader went away (| head): no traceback, nothing more
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
@@ -221,28 +218,6 @@ def _quiet(quiet: bool, *, own_process: bool) -> Iterator[None]:
         logging.disable(level)
 
 
-def _import_silently(module: str) -> None:
-    """Import ``module`` with the process's stderr (file descriptor 2) pointed at /dev/null
-    meanwhile: PyBullet prints its build time there as it loads."""
-    if module in sys.modules:
-        return
-    try:
-        sys.stderr.flush()
-        saved = os.dup(2)
-    except (OSError, ValueError):  # no stderr to silence
-        return
-    try:
-        null = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(null, 2)
-        os.close(null)
-        with contextlib.suppress(ImportError):
-            importlib.import_module(module)
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
-
-
-SIMULATING = frozenset({"run", "study", "tune", "serve", "chat", "export"})  # may load PyBullet
 HANDLED = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP")
                 if hasattr(signal, n))
 

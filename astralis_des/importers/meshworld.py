@@ -140,9 +140,9 @@ def _areas(tri: FloatArray, cells: np.ndarray, levels: list[float], shape: tuple
 def _convex_parts(vertices: FloatArray, faces: np.ndarray
                   ) -> list[tuple[FloatArray, np.ndarray]]:
     """Convex parts by PyBullet's V-HACD (quiet: it prints its progress)."""
-    import pybullet as pb
     import trimesh
 
+    from astralis_des.physics import pb  # PyBullet, loaded quietly
     from astralis_des.physics.quiet import quiet_c_output
 
     with tempfile.TemporaryDirectory(prefix="astralis-vhacd-") as folder:
