@@ -1,14 +1,22 @@
 """What each agent kind is: one record (:class:`KindDefaults`) carrying its speed, camera,
 sensor height and sensor set, its body (for the planners, the local layer and the lidar), how it
-moves between floors, which planner plans its legs and which rooms are its hazard. Code elsewhere
-asks the record (``KIND_DEFAULTS[kind].flies``), never compares the kind's name; a new kind is
-one more entry here (and its actions, driver and looks registered where those live)."""
+moves between floors, which planner plans its legs, which rooms are its hazard, the Eq. 1
+weights it reads and how a recording draws it. Code elsewhere asks the record
+(``KIND_DEFAULTS[kind].flies``), never compares the kind's name.
+
+A new kind is registered from a plug-in (:func:`register_kind`), with its actions
+(:func:`astralis_des.plugins.action`), its physics driver (``astralis_des.physics.drivers``'s
+``DRIVERS``) and, if it needs them, its planner and look; ``examples/plugins/`` adds a legged
+robot that way. ``KINDS`` is a live view: it lists the kinds registered so far.
+"""
 
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, overload
 
 
 @dataclass(frozen=True)
@@ -50,6 +58,8 @@ class KindDefaults:
     carries: tuple[str, ...] | None = None  # the sensors it can carry (None: every one)
     look: str = "rover"  # how a recording draws it (astralis_des.sinks.looks.LOOKS)
     color: tuple[int, int, int] = (200, 200, 200)  # its node in a recording's round graph
+    weights: str | None = None  # the kind whose Eq. 1 weights it reads where the mission sets
+    # none for it (None: its own, 0 where unset)
 
     @property
     def flies(self) -> bool:
@@ -112,8 +122,60 @@ KIND_DEFAULTS: dict[str, KindDefaults] = {
                           band=(-1.6, 0.15), hazard="risk", person=True,
                           carries=("camera",), look="person", color=(220, 20, 60)),
 }
-KINDS = tuple(KIND_DEFAULTS)
-LARGEST = max(KINDS, key=lambda k: KIND_DEFAULTS[k].length)  # the kind of the longest body
+BUILT_IN = tuple(KIND_DEFAULTS)  # the paper's three
+NAME = re.compile(r"^[a-z][a-z0-9_]*$")
+
+
+class _Kinds(Sequence[str]):
+    """The names of the kinds registered so far, in the order they were (the paper's three
+    first): a view, so what a plug-in adds later is in it."""
+
+    @overload
+    def __getitem__(self, i: int) -> str: ...
+    @overload
+    def __getitem__(self, i: slice) -> Sequence[str]: ...
+
+    def __getitem__(self, i: int | slice) -> str | Sequence[str]:
+        return tuple(KIND_DEFAULTS)[i]
+
+    def __len__(self) -> int:
+        return len(KIND_DEFAULTS)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(tuple(KIND_DEFAULTS))
+
+    def __contains__(self, kind: object) -> bool:
+        return kind in KIND_DEFAULTS
+
+    def __repr__(self) -> str:
+        return repr(tuple(KIND_DEFAULTS))
+
+
+KINDS: Sequence[str] = _Kinds()
+
+
+def register_kind(name: str, record: KindDefaults) -> KindDefaults:
+    """Add the kind ``name`` (lower-case letters, digits and ``_``); registering a name twice
+    is a bug and is refused, unless with the same record (a plug-in imported again)."""
+    if not NAME.match(name):
+        raise ValueError(f"a kind's name is lower-case letters, digits and _, not {name!r}")
+    if name in KIND_DEFAULTS and KIND_DEFAULTS[name] != record:
+        raise ValueError(f"robot kind {name!r} is registered twice")
+    KIND_DEFAULTS[name] = record
+    return record
+
+
+def largest() -> str:
+    """The kind of the longest body registered (the UGV's, of the paper's three)."""
+    return max(KINDS, key=lambda k: KIND_DEFAULTS[k].length)
+
+
+def known_kind(kind: str) -> str:
+    """``kind`` if registered, else a ``ValueError`` naming those that are."""
+    if kind not in KIND_DEFAULTS:
+        raise ValueError(f"unknown robot kind {kind!r}; known: {', '.join(KINDS)} (a "
+                         "plug-in adds others: plugins: [file.py])")
+    return kind
 TARGET_HEIGHT = 0.5  # m above the floor: the centre of a sitting or laying avatar
 TARGET_SIZE = (0.5, 0.5, 2 * TARGET_HEIGHT)  # m: the box of a sitting avatar
 TARGET_FACE = TARGET_SIZE[1] * TARGET_SIZE[2]  # m^2: its side, seen square on

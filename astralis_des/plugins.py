@@ -17,6 +17,10 @@ record (:class:`~astralis_des.action_spec.ActionSpec`), its parameters a pydanti
     def zigzag(ctx, robot, task): ...
 
 A bare function registered with ``@ACTIONS.register(("uav", "zigzag"))`` takes any params.
+
+A robot kind is one record (:class:`~astralis_des.kinds.KindDefaults`), added with
+:func:`robot_kind`; ``examples/plugins/legged.py`` adds a legged robot with its own action,
+planner, physics driver and look.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ from collections.abc import Callable
 from typing import Any, TypeVar
 
 from astralis_des.action_spec import ActionSpec, AnyParams
+from astralis_des.kinds import KINDS, KindDefaults, register_kind
 from astralis_des.registry import Registry
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -77,6 +82,18 @@ def action(name: str, kinds: tuple[str, ...], **about: Any) -> Callable[[F], F]:
         return run
 
     return add
+
+
+def robot_kind(name: str, record: KindDefaults,
+               share: dict[str, str] | None = None) -> KindDefaults:
+    """Register the robot kind ``name``. It runs ``move`` as every kind does, and each action
+    ``share`` names (``{action: kind}``) with that kind's record; its own actions register
+    with :func:`action`."""
+    register_kind(name, record)
+    for verb, like in {"move": KINDS[0], **(share or {})}.items():
+        if (name, verb) not in ACTIONS:
+            ACTIONS.register((name, verb))(ACTIONS.get((like, verb)))
+    return record
 
 
 def actions_for(kind: str) -> list[str]:

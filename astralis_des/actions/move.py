@@ -22,7 +22,7 @@ class MoveParams(ActionParams):
     look: Number = Field(0.0, ge=0.0, le=1.0, description="1: watch for the target on the way")
 
 
-@action("move", KINDS, params=MoveParams, point=True,
+@action("move", tuple(KINDS), params=MoveParams, point=True,
         verbs=(Verb("move", "go to a room (its centre) or to a point x y"),))
 def move(ctx: Context, robot: Robot, task: Task) -> ActionGen:
     """Go to a room's centre (``point``: ``center``) or door (``door``), or to the point

@@ -38,6 +38,18 @@ class Weights:
     def zero(cls) -> Weights:
         return cls({}, {})
 
+    def of(self, kind: str) -> tuple[float, float]:
+        """``kind``'s W1 and W2: its own where set, else those of the kind its record reads
+        (:attr:`astralis_des.kinds.KindDefaults.weights`), else 0."""
+        like = KIND_DEFAULTS[kind].weights if kind in KIND_DEFAULTS else None
+
+        def one(w: Mapping[str, float]) -> float:
+            if kind in w:
+                return float(w[kind])
+            return float(w.get(like, 0.0)) if like is not None else 0.0
+
+        return one(self.risk), one(self.messiness)
+
 
 def distances(agents: Sequence[Agent], rooms: Sequence[RoomInfo]) -> NDArray[np.float64]:
     """``(A, R)``: l2 for UAVs, Manhattan for the UGV and the human (their paths bend)."""
@@ -58,6 +70,6 @@ def eq1_costs(agents: Sequence[Agent], rooms: Sequence[RoomInfo],
     norm = np.divide(d, mean, out=np.zeros_like(d), where=mean > 0)
     risk = np.array([rm.risk for rm in rooms])
     mess = np.array([rm.messiness for rm in rooms])
-    w1 = np.array([weights.risk.get(ag.kind, 0.0) for ag in agents])
-    w2 = np.array([weights.messiness.get(ag.kind, 0.0) for ag in agents])
+    w = np.array([weights.of(ag.kind) for ag in agents], dtype=float).reshape(len(agents), 2)
+    w1, w2 = w[:, 0], w[:, 1]
     return np.asarray(norm + w1[:, None] * risk[None, :] + w2[:, None] * mess[None, :])

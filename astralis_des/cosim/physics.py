@@ -25,7 +25,7 @@ from astralis_des.kernel.contracts import CoSim, Host, MotionOutcome, Sensor
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.physics.client import PhysicsClient
-from astralis_des.physics.drivers import DRIVERS, Driver, DriverClass, HumanDriver
+from astralis_des.physics.drivers import DRIVERS, Driver, DriverClass, HumanDriver, PlacedDriver
 from astralis_des.physics.hexacopter import write_urdf
 from astralis_des.physics.lift import Lift, lifts_of
 from astralis_des.physics.local import RATE as LOCAL_RATE
@@ -72,7 +72,7 @@ class PhysicsCoSim:
             if isinstance(driver, UgvDriver):
                 driver.lifts = self.lifts
                 driver.column_busy = self._column_busy
-            if isinstance(driver, HumanDriver):
+            if isinstance(driver, PlacedDriver):
                 driver.bodies_near = self._bodies_near(rid)
                 driver.robot_of = {d.body: other for other, d in self.drivers.items()}
         self._scene = sim.scene
@@ -136,7 +136,7 @@ class PhysicsCoSim:
         """For a walker: the bodies of the other robots (UAVs, UGVs) within 1.5 m of a point,
         and the lifts'."""
         others = [d for other, d in self.drivers.items()
-                  if other != rid and not isinstance(d, HumanDriver)]
+                  if other != rid and not isinstance(d, PlacedDriver)]
 
         def near(point: FloatArray) -> list[int]:
             found = [d.body for d in others

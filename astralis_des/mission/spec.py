@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import ConfigDict, Field, field_validator, model_validator
 
+from astralis_des.kinds import known_kind
 from astralis_des.mission.sensor_spec import (  # noqa: F401  (re-exported)
     _DEFAULT_SPECS,
     POSE_SENSORS,
@@ -100,9 +101,20 @@ class TargetSpec(Strict):
 
 
 class KindWeights(Strict):
+    """A weight per kind, a plug-in's kind too (unset, it reads its record's ``weights``)."""
+
+    model_config = ConfigDict(extra="allow", frozen=True)
+    __pydantic_extra__: dict[str, NonNegativeFloat] = Field(init=False)
+
     human: NonNegativeFloat = 0.0
     uav: NonNegativeFloat = 0.0
     ugv: NonNegativeFloat = 0.0
+
+    @model_validator(mode="after")
+    def _known_kinds(self) -> KindWeights:
+        for kind in self.model_extra or {}:
+            known_kind(kind)
+        return self
 
 
 class WeightsSpec(Strict):

@@ -6,6 +6,8 @@ from typing import Annotated, Literal
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
+from astralis_des.kinds import KINDS, known_kind
+
 # Every number is finite: no .inf time limits, no .nan positions; and no coordinate beyond
 # what any site holds (1,000 km), so arithmetic on it cannot overflow.
 Finite = Annotated[float, Field(allow_inf_nan=False, ge=-1e6, le=1e6)]
@@ -13,7 +15,9 @@ PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 MAX_SPEED = 100.0  # m/s: faster than any robot of a search team (a speed of 1e308 overflowed)
 NonNegativeFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 Vec3 = tuple[Finite, Finite, Finite]
-Kind = Literal["uav", "ugv", "human"]
+# a registered robot kind (the paper's three, or one a plug-in adds: astralis_des.kinds)
+Kind = Annotated[str, AfterValidator(known_kind),
+                 Field(json_schema_extra=lambda schema: schema.update(enum=list(KINDS)))]
 Unit = Annotated[float, Field(ge=0.0, le=1.0)]
 Sound = Literal["minimal", "moderate", "loud"]
 NAME_MAX = 200  # characters of a name that becomes a folder (file systems allow 255 bytes)

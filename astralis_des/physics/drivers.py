@@ -10,6 +10,7 @@ modules and register here.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Protocol
@@ -19,7 +20,7 @@ import numpy as np
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.mission.spec import PhysicsSpec
 from astralis_des.physics.client import PhysicsClient
-from astralis_des.physics.walker import HEIGHT, RADIUS, Walker
+from astralis_des.physics.walker import Walker
 from astralis_des.registry import Registry
 from astralis_des.world.geometry import FloatArray
 
@@ -100,15 +101,33 @@ class Avoiding:
         return None
 
 
-@DRIVERS.register("human")
-class HumanDriver(Avoiding):
-    """Walks the path at its speed, kinematically: a capsule placed at each tick."""
+class PlacedBody(Protocol):
+    """A body a :class:`PlacedDriver` puts where it should be each control period."""
+
+    body: int
+    centre_height: float  # m from the floor to its centre
+
+    def __init__(self, client: PhysicsClient, centre: FloatArray) -> None: ...
+    def place(self, centre: FloatArray, yaw: float) -> None: ...
+    def position(self) -> FloatArray: ...
+
+
+class PlacedDriver(Avoiding):
+    """Follows the path at its speed, kinematically: its body (``body_class``) placed at each
+    tick, never into another robot's body (it waits instead). A person's driver; a plug-in's
+    kind whose gait is not simulated (``examples/plugins/legged.py``) subclasses it with its
+    own body."""
+
+    body_class: type[PlacedBody] = Walker
+    turns = False  # its body is turned to the way it goes (a person's capsule need not be)
 
     def __init__(self, client: PhysicsClient, robot: Robot, spec: PhysicsSpec, urdf: Path) -> None:
         self.client = client
-        self.offset = np.array([0.0, 0.0, robot.height - (RADIUS + HEIGHT / 2)])
+        self.centre_height = self.body_class.centre_height
+        self.offset = np.array([0.0, 0.0, robot.height - self.centre_height])
         self.period = 1.0 / spec.control_rate
-        self.walker = Walker(client, robot.pose - self.offset)
+        self.walker = self.body_class(client, robot.pose - self.offset)
+        self.yaw = robot.heading  # rad: where its body faces (the way it last went)
         self.body = self.walker.body
         self.placed = np.asarray(robot.pose - self.offset, dtype=float)
         self.motion: Motion | None = None
@@ -151,12 +170,14 @@ class HumanDriver(Avoiding):
         where[:2] += self.shift
         near = self.bodies_near(where)
         depth = self._overlap(near)
-        self.walker.place(where)
+        if self.turns:
+            self._face()
+        self.walker.place(where, self.yaw)
         self.placed = where
         self.blocked_by = ()
         if near and self._overlap(near) > depth + 1e-4:  # it would step into a robot: wait
             self.elapsed, self.shift, self.placed = before
-            self.walker.place(self.placed)
+            self.walker.place(self.placed, self.yaw)
             self.blocked_by = tuple(self.robot_of.get(b, "") for b in near)
         if self.elapsed >= self.motion.duration:
             return "arrived"
@@ -164,6 +185,12 @@ class HumanDriver(Avoiding):
         if self.held and remaining < ARRIVED:  # held a step from its goal: it is there
             return "arrived"
         return "arrived" if remaining < self.arrive_within - ARRIVED else None
+
+    def _face(self) -> None:
+        """Turn to the way it goes now (where it stands still, the way it last went)."""
+        dx, dy = (float(v) for v in self.heading_vector())
+        if dx * dx + dy * dy > 1e-12:
+            self.yaw = math.atan2(dy, dx)
 
     def _overlap(self, bodies: list[int]) -> float:
         """How deep the walker is in any of ``bodies`` where it stands now (0 if in none)."""
@@ -184,10 +211,15 @@ class HumanDriver(Avoiding):
         """A walker does not crash."""
 
     def recover(self, at: FloatArray) -> None:
-        self.walker.place(at + np.array([0.0, 0.0, RADIUS + HEIGHT / 2]))
+        self.walker.place(at + np.array([0.0, 0.0, self.centre_height]), self.yaw)
 
     def freeze(self) -> None:
         """A walker is kinematic: standing still costs nothing."""
+
+
+@DRIVERS.register("human")
+class HumanDriver(PlacedDriver):
+    """Walks the path at its speed, kinematically: a capsule placed at each tick."""
 
 
 def ramp(current: FloatArray, target: FloatArray, step: float) -> FloatArray:

@@ -12,6 +12,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from astralis_des.errors import InputError
+from astralis_des.kinds import KINDS
 from astralis_des.world.geometry import Box
 from astralis_des.world.imported import Imported, area_rooms, ground_slab, load_geometry
 from astralis_des.world.model import Building, Door, Room, Segment, Solid, Space, World
@@ -68,17 +69,19 @@ def _road_box(start: tuple[float, float], end: tuple[float, float], width: float
 
 
 def load_world(path: Path) -> World:
-    """Read, validate and build a world file. Built once for each content of the file: a
-    file edited between two loads in one process (a notebook, a server) is read anew."""
+    """Read, validate and build a world file. Built once for each content of the file and
+    set of robot kinds: a file edited between two loads in one process (a notebook, a
+    server) is read anew, and so is one loaded again after a plug-in added a kind (its
+    routes and stairs are for every kind)."""
     try:  # a FIFO or a device is refused, never read
         digest = hashlib.sha256(read_bytes(path)).hexdigest()
     except InputError:
         digest = ""  # load_yaml says what is wrong with the path
-    return _built(Path(path), digest)
+    return _built(Path(path), digest, tuple(KINDS))
 
 
 @lru_cache(maxsize=16)
-def _built(path: Path, _digest: str) -> World:
+def _built(path: Path, _digest: str, _kinds: tuple[str, ...]) -> World:
     return read_world(path)
 
 

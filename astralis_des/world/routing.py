@@ -12,6 +12,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections import OrderedDict
+from collections.abc import Sequence
 from typing import Protocol
 
 import numpy as np
@@ -120,7 +121,7 @@ class Router:
         self._pos.append(pos)
         return self.index[name]
 
-    def _edge(self, u: int, v: int, kinds: tuple[str, ...] = KINDS,
+    def _edge(self, u: int, v: int, kinds: Sequence[str] = KINDS,
               length: float | None = None) -> None:
         d = length if length is not None else math.dist(self._pos[u], self._pos[v])
         self._edges.append((u, v, dict.fromkeys(kinds, d)))

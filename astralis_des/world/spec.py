@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Annotated, Literal
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
@@ -15,7 +16,7 @@ from pydantic import (
     model_validator,
 )
 
-from astralis_des.kinds import KIND_DEFAULTS, LARGEST
+from astralis_des.kinds import KIND_DEFAULTS, KINDS, known_kind, largest
 
 # Every number is finite (no .nan origin, no .inf size) and no coordinate or size is beyond
 # what any site holds (1,000 km, as in missions), so that arithmetic on them cannot overflow.
@@ -26,8 +27,9 @@ Finite = Annotated[float, Field(allow_inf_nan=False)]
 Vec2 = tuple[Coordinate, Coordinate]
 Vec3 = tuple[Coordinate, Coordinate, Coordinate]
 Size3 = tuple[Length, Length, Length]
-Kind = Literal["uav", "ugv", "human"]
-KINDS: tuple[Kind, ...] = ("uav", "ugv", "human")
+# a registered robot kind (the paper's three, or one a plug-in adds)
+Kind = Annotated[str, AfterValidator(known_kind),
+                 Field(json_schema_extra=lambda schema: schema.update(enum=list(KINDS)))]
 
 
 class Strict(BaseModel):
@@ -36,11 +38,14 @@ class Strict(BaseModel):
 
 MIN_WALL = 0.05  # m: a wall 1e-9 m thick made rooms of triangles of no area
 MAX_ROOMS = 10_000  # rooms of a world: loaded and routed in 0.6 s and 0.14 GB (bench_world)
-ROBOT = KIND_DEFAULTS[LARGEST].length  # m: a room or a corridor must hold the longest body
+def robot() -> tuple[str, float]:
+    """The longest body's kind and length (m): a room or a corridor must hold it."""
+    kind = largest()
+    return kind, KIND_DEFAULTS[kind].length
 
 
 def fits_a_robot(inside: tuple[float, ...]) -> bool:
-    return min(inside) >= ROBOT
+    return min(inside) >= robot()[1]
 
 
 class SegmentSpec(Strict):
@@ -83,8 +88,9 @@ class BuildingSpec(Strict):
         what = (f"rooms of {sides[0]:g} x {sides[1]:g} m are "
                 f"{max(sides[0] - t, 0):.2f} x {max(sides[1] - t, 0):.2f} m" if len(sides) == 2
                 else f"a corridor {sides[0]:g} m wide is {max(sides[0] - t, 0):.2f} m")
+        kind, length = robot()
         raise ValueError(f"{what} inside their {t:g} m walls: smaller than a robot (a "
-                         f"{LARGEST} is {ROBOT:g} m long); make each at least {ROBOT + t:g} m")
+                         f"{kind} is {length:g} m long); make each at least {length + t:g} m")
 
     @model_validator(mode="after")
     def _not_too_big(self) -> BuildingSpec:
@@ -150,8 +156,9 @@ class AreaSpec(Strict):
         if not all(a < b for a, b in zip(lo, hi, strict=True)):
             raise ValueError(f"box: each coordinate of {list(lo)} must be below {list(hi)}")
         if not fits_a_robot((hi[0] - lo[0], hi[1] - lo[1])):
+            kind, length = robot()
             raise ValueError(f"box: an area of {hi[0] - lo[0]:g} x {hi[1] - lo[1]:g} m is "
-                             f"smaller than a robot (a {LARGEST} is {ROBOT:g} m long)")
+                             f"smaller than a robot (a {kind} is {length:g} m long)")
         return self
 
 
