@@ -79,13 +79,21 @@ class GeometricSensor:
         for start in range(0, len(near), CHUNK):
             idx = near[start:start + CHUNK]
             pixels = predict_pixels(view, pts[idx], headings[idx], targets[idx], size,
-                                    self.scene.line_of_sight)
+                                    self._sight)
             hits = np.flatnonzero(pixels >= view.min_pixels)
             if len(hits):
                 i, count = int(idx[hits[0]]), int(pixels[hits[0]])
                 return self._sighting(view.position_noise, pts[i], targets[i], float(times[i]),
                                       count)
         return None
+
+    def _sight(self, p0: FloatArray, p1: FloatArray) -> np.ndarray:
+        """Where nothing lies between ``p0[m]`` and ``p1[m]``. Looking into a room is what
+        furnishes it (in kinematic fidelity, the team's first look at it): the rooms the
+        lines start or end in are furnished first, then the scene is asked."""
+        scene = self.scene
+        scene.furnish(scene.rooms_at(np.concatenate([np.atleast_2d(p0), np.atleast_2d(p1)])))
+        return scene.line_of_sight(p0, p1)
 
     def _sighting(self, noise_share: float, eye: FloatArray, target: FloatArray, t: float,
                   pixels: int) -> Sighting:
@@ -153,7 +161,7 @@ class GeometricSensor:
                 seen[ci[in_room[pi]]] = True
             left = ~seen[ci]
             if left.any():
-                clear = self.scene.line_of_sight(pts[pi[left]], cells[ci[left]])
+                clear = self._sight(pts[pi[left]], cells[ci[left]])
                 seen[ci[left][clear]] = True
         return float(seen.mean())
 

@@ -78,9 +78,11 @@ def test_open_air_areas_get_bystanders_but_no_furniture_unless_asked() -> None:
                            "autzen_recon.yaml")
     rooms = {rid: {"messiness": 1.0} for rid in ("S.1.1.1", "S.1.1.2", "S.1.2.1", "S.1.2.2")}
     plain = Simulation(mission.with_changes(rooms={"set": rooms}))
+    plain.scene.furnish(rooms)
     kinds = {p.kind for rid in rooms for p in plain.scene.clutter(rid).placed}
     assert kinds == {"avatar"}
     asked = Simulation(mission.with_changes(rooms={"set": rooms},
                                             scene={"furnish_outdoors": True}))
+    asked.scene.furnish(rooms)
     kinds = {p.kind for rid in rooms for p in asked.scene.clutter(rid).placed}
     assert "avatar" in kinds and kinds - {"avatar"}

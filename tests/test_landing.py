@@ -31,7 +31,7 @@ def hovering(sim: Simulation, rid: str, at: tuple[float, float, float]) -> np.nd
     robot = sim.robots[rid]
     room = sim.world.room_at((at[0], at[1], sim.world.floor_below(at) + 0.5))
     if room is not None:
-        sim.scene.clutter(room.id)
+        sim.scene.furnish([room.id])
     robot.pose = np.array(at, dtype=float)
     robot.airborne = True
     return landing_way(sim, robot)

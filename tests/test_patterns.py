@@ -155,7 +155,7 @@ def test_a_uav_searches_a_room_over_the_heads_of_standing_people() -> None:
     inside = np.array([sim.world.room_at(p - [0, 0, 1.0]) is not None for p in points])
     z = np.array([p[2] - sim.world.floor_below(p) for p in points[away & inside]])
     assert len(z) > 20
-    standing = [p for p in sim.scene.all_clutter()
+    standing = [p for p in sim.scene.furnish_all()
                 if dict(p.attributes).get("activity") in ("idle", "patrolling")]
     assert standing
     tallest = max(p.box.hi[2] - p.box.lo[2] for p in standing)

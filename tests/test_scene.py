@@ -55,9 +55,11 @@ def test_target_attributes_come_from_table_ii(urban_search: Mission) -> None:
 def test_a_fixed_target_moves_furniture_aside(world: World) -> None:
     """A target put where furniture would stand displaces it; the report says so."""
     scene = Scene(world, dict.fromkeys(world.rooms, 1.0), 3, default_catalogue())
+    scene.furnish(["A.2.1.2"])
     first = scene.clutter("A.2.1.2").placed[0]
     scene2 = Scene(world, dict.fromkeys(world.rooms, 1.0), 3, default_catalogue())
     scene2.place_target("A.2.1.2", {"activity": "idle"}, first.center)
+    scene2.furnish(["A.2.1.2"])
     placed = scene2.clutter("A.2.1.2").placed
     assert first not in placed
     assert ("A.2.1.2", first.kind, "moved aside for the target") in scene2.skipped()
@@ -67,7 +69,7 @@ def test_the_same_seed_furnishes_the_same_way(world: World) -> None:
     """Same seed and messiness: identical furniture; another seed: different furniture."""
     def furniture(seed: int) -> list[Placed]:
         return Scene(world, dict.fromkeys(world.rooms, 0.7), seed,
-                     default_catalogue()).all_clutter()
+                     default_catalogue()).furnish_all()
 
     assert furniture(5) == furniture(5)
     assert furniture(5) != furniture(6)
@@ -79,7 +81,7 @@ def test_furniture_counts_grow_with_messiness(urban_search: Mission) -> None:
     def count(messiness: float) -> int:
         mission = urban_search.with_changes(rooms={"set": {
             rid: {"messiness": messiness} for rid in urban_search.world.rooms}})
-        return len(Simulation(mission).scene.all_clutter())
+        return len(Simulation(mission).scene.furnish_all())
 
     assert count(0.0) == 0
     assert count(1.0) > 150
@@ -152,6 +154,7 @@ def test_a_custom_catalogue_is_used(tmp_path: Path) -> None:
     mission_file = tmp_path / "mission.yaml"
     mission_file.write_text(text + f"scene:\n  catalogue: {catalogue.name}\n", encoding="utf-8")
     sim = Simulation(load_mission(mission_file))
+    sim.scene.furnish(["A.1.1.2"])
     kinds = {p.kind for p in sim.scene.clutter("A.1.1.2").placed}
     assert kinds == {"potted_plant"}
 
@@ -208,3 +211,21 @@ def test_items_a_room_has_no_place_for_are_events(urban_search: Mission, tmp_pat
     assert result.events[0]["kind"] == "mission_start"
     lines = (tmp_path / "events.jsonl").read_text(encoding="utf-8").splitlines()
     assert len(lines) == len(result.events)
+
+
+def test_a_query_never_furnishes_a_room(world: World) -> None:
+    """Furnishing is an explicit step: asking about a room not furnished yet is refused and
+    changes nothing; furnishing tells the listeners once, however often it is asked."""
+    told: list[str] = []
+    scene = Scene(world, dict.fromkeys(world.rooms, 1.0), 3, default_catalogue())
+    scene.listeners.append(lambda room, clutter: told.append(room))
+    with pytest.raises(LookupError, match="room A.2.1.2 is not furnished yet"):
+        scene.clutter("A.2.1.2")
+    with pytest.raises(LookupError):
+        scene.still_boxes(["A.2.1.2"])
+    assert scene.furnished_rooms() == [] and told == []
+    scene.furnish(["A.2.1.2", "A.1.1.1"])
+    scene.furnish(["A.2.1.2"])
+    assert told == ["A.2.1.2", "A.1.1.1"]
+    assert scene.furnished_rooms() == ["A.1.1.1", "A.2.1.2"]
+    assert len(scene.clutter("A.2.1.2").placed) > 0

@@ -128,7 +128,7 @@ def go_to(ctx: Context, robot: Robot, goal_floor: tuple[float, ...],
 
 def search_path(ctx: Context, robot: Robot, room: Room, plan: FloatArray, label: str) -> ActionGen:
     """Go to the start of a coverage path ``plan`` (floor level) and follow it, sensing."""
-    ctx.sensor.scene.clutter(room.id)  # the room is furnished before the robot goes in
+    ctx.sensor.scene.furnish([room.id])  # the room is furnished before the robot goes in
     pattern = at_height(robot, plan)
     fitting = ctx.navigator.usable(robot, pattern)  # where the body fits among the furniture
     assert fitting.points is not None

@@ -48,6 +48,7 @@ def landing_way(ctx: Context, robot: Robot) -> FloatArray:
     room = ctx.world.room_at((here[0], here[1], floor + 0.5))
     rooms = [room.id] if room is not None else []
     scene = ctx.sensor.scene
+    scene.furnish(rooms)  # the room it lands in, with its furniture
     taken = _taken(ctx, robot, here, rooms)
     solid = scene.blockers(rooms)
     for reach in LANDING_RINGS:
@@ -98,6 +99,7 @@ def _taken(ctx: Context, robot: Robot, here: FloatArray, rooms: list[str]) -> Fl
     the target, the loops walkers go round, and the other robots (a UGV under it in a
     corridor)."""
     scene = ctx.sensor.scene
+    scene.furnish(rooms)
     boxes = scene.blockers(rooms)
     walks = [*scene.movers, *scene.avatar_movers(rooms)]
     target = scene.target

@@ -30,7 +30,7 @@ def move(ctx: Context, robot: Robot, task: Task) -> ActionGen:
     args = MoveParams.model_validate(dict(task.params))
     room = room_of(ctx, task)
     if room is not None:
-        ctx.sensor.scene.clutter(room.id)  # its furniture is there before the robot is
+        ctx.sensor.scene.furnish([room.id])  # its furniture is there before the robot is
         goal = room.center if args.point == "center" else room.door_point("corridor",
                                                                           stand_off(robot))
     elif args.x is not None and args.y is not None:

@@ -29,7 +29,7 @@ from astralis_des.physics.drivers import DRIVERS, Driver, DriverClass, HumanDriv
 from astralis_des.physics.hexacopter import write_urdf
 from astralis_des.physics.lift import Lift, lifts_of
 from astralis_des.physics.local import RATE as LOCAL_RATE
-from astralis_des.physics.local import LocalLayer
+from astralis_des.physics.local import LocalLayer, Requests
 from astralis_des.physics.make_way import aside
 from astralis_des.physics.perception import Perception
 from astralis_des.physics.sensors import _body_pose
@@ -87,6 +87,7 @@ class PhysicsCoSim:
         self.touching: set[tuple[str, str]] = set()
         self._wake: simpy.Event = self.env.event()
         self._next_log = 0.0
+        self._asked: Requests = {}  # robots asked to make way in this macro-step
         self._no_room: dict[str, float] = {}  # robots that found no spot to make way, until
         self._ticks = 0
         self.env.process(self._stepper())
@@ -98,7 +99,7 @@ class PhysicsCoSim:
         self.movers: list[tuple[Mover, int]] = []
         self.movers_time = 0.0  # the time the movers were last put at
         self._add_movers([*scene.movers, *scene.avatar_movers()])
-        for room_id in sorted(scene._rooms):
+        for room_id in scene.furnished_rooms():
             self._furnish(room_id, scene.clutter(room_id), movers=False)
         scene.listeners.append(self._furnish)
         self.target = target = sim.target
@@ -307,8 +308,10 @@ class PhysicsCoSim:
             check = self._ticks % check_every == 0
             make_way = False
             if self._ticks % local_every == 0:
-                self.local.update(self.t)
-                make_way = bool(self.local.requests)  # end the macro-step after this tick
+                asked = self.local.update(self.t)
+                for rid, request in asked.items():  # the first to ask in the macro-step
+                    self._asked.setdefault(rid, request)
+                make_way = bool(self._asked)  # end the macro-step after this tick
             finished = [(rid, out) for rid, (robot, track, _) in self.active.items()
                         if (out := self._tick(rid, track, check)) is not None]
             if finished:
@@ -360,7 +363,7 @@ class PhysicsCoSim:
     def _make_way(self) -> None:
         """Robots standing idle in another's way move to the nearest free spot off its path
         (asked by the local layer during the last macro-step)."""
-        requests, self.local.requests = self.local.requests, {}
+        requests, self._asked = self._asked, {}
         for rid, (asker, path) in sorted(requests.items()):
             robot = self.robots[rid]
             if rid in self.active or robot.faulted or self._no_room.get(rid, -1.0) > self.t:

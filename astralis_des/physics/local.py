@@ -56,6 +56,9 @@ SHARES = (1.0, 2 / 3, 1 / 3)  # of a keep-right shift, tried in turn
 ROUND_MARGIN = 0.05  # m beyond the lane a robot stepping round a standing body keeps
 MAKE_WAY_PATH = 6.0  # m of the asking robot's path that a robot making way keeps off
 
+# robot standing in another's way -> (the robot asking it to make way, that one's path ahead)
+Requests = dict[str, tuple[str, FloatArray]]
+
 
 class LocalLayer:
     def __init__(self, cosim: Engine, order: list[str]) -> None:
@@ -65,9 +68,6 @@ class LocalLayer:
         self.shifts = 0  # how many times a robot was shifted aside
         self.climbs = 0  # how many times a UAV climbed over a walker
         self.near: list[int] = []  # movers within NEAR of a moving robot: the ones to move
-        # robots standing in another's way: who asks them to make way, and its path ahead
-        self.requests: dict[str, tuple[str, FloatArray]] = {}
-        self._deciding = ""  # the robot whose moves are being decided
         self._paths: dict[str, FloatArray] = {}  # where each moving robot will be, xy
         self.climber = Climber(cosim.fits)
         self.solids = cosim.world.solid_array
@@ -103,11 +103,14 @@ class LocalLayer:
                                   lift.z_range, lift.radius, STILL_RANK, lift.z_range))
         return found
 
-    def update(self, t: float) -> None:
-        """Decide, for each moving robot, whether to hold and how far to shift aside."""
+    def update(self, t: float) -> Requests:
+        """Decide, for each moving robot, whether to hold and how far to shift aside (set on
+        its driver); return the robots standing in another's way, each with who asks it to
+        make way and that one's path ahead (the first to ask, in team order)."""
+        requests: Requests = {}
         if not self.cosim.active:
             self.near = []
-            return
+            return requests
         bodies = self.bodies(t)
         where = np.array([b.xy for b in bodies])
         robots = len(self.cosim.drivers)
@@ -123,12 +126,12 @@ class LocalLayer:
             mover = self.cosim.movers[i][0]
             self._paths[mover.id] = mover.positions_at(t + MOVER_AHEAD)[:, :2]
         for rid in self.cosim.active:
-            self._decide_for(rid, by_name[rid], bodies, where, paths[rid], doors)
+            self._decide_for(rid, by_name[rid], bodies, where, paths[rid], doors, requests)
+        return requests
 
     def _decide_for(self, rid: str, me: Body, bodies: list[Body], where: FloatArray,
-                    ahead: FloatArray, doors: _Doors) -> None:
+                    ahead: FloatArray, doors: _Doors, requests: Requests) -> None:
         driver = self.cosim.drivers[rid]
-        self._deciding = rid
         direction = driver.heading_vector()
         speed = float(np.linalg.norm(direction))
         near = np.linalg.norm(where - me.xy, axis=1) < PASS_RANGE + 1.0
@@ -167,7 +170,7 @@ class LocalLayer:
         for other in [*blockers, *([occupant] if occupant else []), *pressing]:
             if other.name in self.cosim.drivers and other.name not in self.cosim.active and \
                     self.cosim.may_ask(other.name):
-                self.requests.setdefault(other.name, (rid, driver.path_ahead(MAKE_WAY_PATH)))
+                requests.setdefault(other.name, (rid, driver.path_ahead(MAKE_WAY_PATH)))
         in_doorway = self._by_doorway(me.xy, me.base_z[0])
         open_space = door is None and not in_doorway
         climb, coming = self.climber.need(me, others, direction, route, ahead[:, :2] + me.offset,
@@ -175,7 +178,7 @@ class LocalLayer:
             if KIND_DEFAULTS[me.kind].flies else (0.0, [])
         hold = hold or bool(coming)
         if shift.any() and open_space:
-            shift = self._clear_shift(ahead, shift, (1.0,) if aside else SHARES)
+            shift = self._clear_shift(rid, ahead, shift, (1.0,) if aside else SHARES)
         else:
             shift = np.zeros(2)
         if hold:  # waiting for a robot or a walker that comes this way: out of its way too
@@ -241,10 +244,10 @@ class LocalLayer:
         hidden = segments_hit_boxes(a, b, self.solids)
         return [o for o, h in zip(others, hidden, strict=True) if o.kind == "lift" or not h]
 
-    def _clear_shift(self, ahead: FloatArray, shift: FloatArray,
+    def _clear_shift(self, rid: str, ahead: FloatArray, shift: FloatArray,
                      shares: tuple[float, ...]) -> FloatArray:
-        """The largest share of ``shift`` that keeps the path ahead clear, or none."""
-        rid = self._deciding
+        """The largest share of ``shift`` that keeps robot ``rid``'s path ahead clear, or
+        none."""
         points = np.concatenate([ahead + np.array([*(shift * share), 0.0])
                                  for share in shares])  # from the robot's unshifted place on
         fits = self.cosim.fits(rid, points).reshape(len(shares), len(ahead)).all(axis=1)

@@ -241,10 +241,13 @@ class Navigator(Lintels):
         return self._map
 
     def furniture(self, lo: FloatArray, hi: FloatArray) -> FloatArray:
-        """Boxes of still furniture and avatars in the rooms overlapping ``[lo, hi]``."""
+        """Boxes of still furniture and avatars in the rooms overlapping ``[lo, hi]``: those
+        rooms are furnished first (a plan past a room sees its furniture, whether or not
+        anyone has looked in yet)."""
         rooms = [rid for rid, room in self.world.rooms.items()
                  if np.all(np.asarray(room.box.lo) <= hi) and
                  np.all(np.asarray(room.box.hi) >= lo)]
+        self.scene.furnish(rooms)
         return self.scene.still_boxes(rooms)
 
     def _valid(self, robot: Robot, points: FloatArray, radius: float) -> np.ndarray:

@@ -42,7 +42,7 @@ def show_world(world_file: str | Path, messiness: Sequence[float], out: str | Pa
     ids = sorted(world.rooms)
     values = {rid: float(messiness[i % len(messiness)]) for i, rid in enumerate(ids)}
     scene = Scene(world, values, seed, cat)
-    placed = scene.all_clutter()
+    placed = scene.furnish_all()
     out = Path(out)
     with Staging(out, file=True) as folder:  # in place whole, or not at all
         rec = rr.RecordingStream("astralis_des", recording_id=f"world-{world.name}-{seed}")

@@ -119,9 +119,15 @@ class Scene:
         self.movers: list[Mover] = self._corridor_movers(movers, mover_speed)
 
     # -- clutter ---------------------------------------------------------------------------
-    def clutter(self, room_id: str) -> Clutter:
-        """The room's furniture and avatars, placed on first use."""
-        if room_id not in self._rooms:
+    def furnish(self, room_ids: Iterable[str]) -> None:
+        """The explicit step that puts furniture and avatars in rooms: each of ``room_ids``
+        not furnished yet gets its own (drawn from the seed and the room alone, so when it
+        is done does not change what), and the listeners (the physics adds their bodies) and
+        ``on_skipped`` are told. Queries (:meth:`clutter`, :meth:`still_boxes`, ...) never
+        furnish: they ask about rooms furnished already."""
+        for room_id in room_ids:
+            if room_id in self._rooms:
+                continue
             if not self.enabled:
                 self.set_clutter(room_id, Clutter((), ()))
             else:
@@ -135,7 +141,19 @@ class Scene:
                         self.on_skipped(*skipped)
             for listener in self.listeners:
                 listener(room_id, self._rooms[room_id])
-        return self._rooms[room_id]
+
+    def clutter(self, room_id: str) -> Clutter:
+        """A furnished room's furniture and avatars (a ``LookupError`` for a room not
+        furnished yet: :meth:`furnish` it first)."""
+        try:
+            return self._rooms[room_id]
+        except KeyError:
+            raise LookupError(f"room {room_id} is not furnished yet: Scene.furnish it "
+                              "first") from None
+
+    def furnished_rooms(self) -> list[str]:
+        """The rooms furnished so far, in order."""
+        return sorted(self._rooms)
 
     def set_clutter(self, room_id: str, clutter: Clutter) -> None:
         """Furnish a room with ``clutter`` (placement, the target's room, tests)."""
@@ -151,9 +169,10 @@ class Scene:
                        placed.skipped + tuple((room_id, p.kind, "moved aside for the target")
                                               for p in blocked))
 
-    def all_clutter(self) -> list[Placed]:
-        """Every room's furniture and avatars (furnishing the rooms not yet looked into)."""
-        return [p for rid in sorted(self.world.rooms) for p in self.clutter(rid).placed]
+    def furnish_all(self) -> list[Placed]:
+        """Furnish every room (:meth:`furnish`) and give all their furniture and avatars."""
+        self.furnish(sorted(self.world.rooms))
+        return self.furnished()
 
     def furnished(self) -> list[Placed]:
         """The furniture and avatars of the rooms furnished so far: in kinematic fidelity the
@@ -204,6 +223,7 @@ class Scene:
         floor = room.box.lo[2]
         if position is None:
             rng = stream(self.seed, "target", 1)
+            self.furnish([room_id])  # its furniture first: the target finds a free spot
             spot = free_spot(self.world, room_id, self.clutter(room_id), (w, d), rng,
                              self.catalogue)
             if spot is None:  # no free spot left: the room's centre, furniture moved aside
@@ -261,15 +281,20 @@ class Scene:
     def line_of_sight(self, p0: FloatArray, p1: FloatArray) -> np.ndarray:
         """True where nothing lies between ``p0[m]`` and ``p1[m]``. Only the furniture of the
         rooms the segments start or end in can matter: to reach into any other room a
-        segment passes through a wall, which blocks it already."""
+        segment passes through a wall, which blocks it already. Those rooms must be
+        furnished (:meth:`rooms_at` names them)."""
         p0, p1 = np.atleast_2d(p0), np.atleast_2d(p1)
-        ends = np.concatenate([p0, p1])
+        rooms = self.rooms_at(np.concatenate([p0, p1]))
+        return ~segments_hit_boxes(p0, p1, self.blockers(rooms))
+
+    def rooms_at(self, points: FloatArray) -> list[str]:
+        """The rooms any of ``points`` lies in, in the world's order."""
+        ends = np.atleast_2d(points)
         boxes = self.world.room_boxes
         near = np.flatnonzero(np.all((boxes[:, 0] <= ends.max(axis=0)) &
                                      (boxes[:, 1] >= ends.min(axis=0)), axis=1))
-        rooms = [self.world.room_ids[k] for k in near if np.any(np.all(
+        return [self.world.room_ids[k] for k in near if np.any(np.all(
             (ends >= boxes[k, 0]) & (ends <= boxes[k, 1]), axis=1))]
-        return ~segments_hit_boxes(p0, p1, self.blockers(rooms))
 
 
 def _overlap(a: Box, b: Box) -> bool:
