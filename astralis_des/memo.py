@@ -18,7 +18,12 @@ What is kept, on what (``kept(owner, NAME)``):
 - on a room's **free space**: ``empty_reach`` (where a robot reaches in the empty room).
 
 Elsewhere, once per process and by value (``functools``): the packaged clutter catalogue, the
-ROS 2 message types, a camera's swath by view and height, a catalogue without its furniture.
+ROS 2 message types, a camera's swath by view and height, a catalogue without its furniture,
+and the built worlds themselves (by file content and the robot kinds registered).
+
+The registries (kinds, actions, strategies, planners, drivers, looks, event kinds) fill as
+their modules and the plug-ins are imported, and last for the process: a plug-in a mission
+names is imported once, and its kinds and actions stay for the missions after it.
 """
 
 from __future__ import annotations
