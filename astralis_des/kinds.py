@@ -173,8 +173,9 @@ def largest() -> str:
 def known_kind(kind: str) -> str:
     """``kind`` if registered, else a ``ValueError`` naming those that are."""
     if kind not in KIND_DEFAULTS:
-        raise ValueError(f"unknown robot kind {kind!r}; known: {', '.join(KINDS)} (a "
-                         "plug-in adds others: plugins: [file.py])")
+        known = ", ".join(repr(k) for k in KINDS)
+        raise ValueError(f"unknown robot kind {kind!r}; known: {known} (a plug-in adds "
+                         "others: plugins: [file.py])")
     return kind
 TARGET_HEIGHT = 0.5  # m above the floor: the centre of a sitting or laying avatar
 TARGET_SIZE = (0.5, 0.5, 2 * TARGET_HEIGHT)  # m: the box of a sitting avatar

@@ -106,10 +106,12 @@ class GeometricSensor:
     def coverage(self, robot: Robot, points: FloatArray, room: Room,
                  headings: FloatArray | None = None) -> float:
         """Share of ``room``'s free floor cells (not under furniture) seen from the path
-        ``points`` (facing its direction of travel, or ``headings`` given per point)."""
+        ``points`` (facing its direction of travel, or ``headings`` given per point). The
+        robot looks into the room: it is furnished first if it was not yet."""
         if robot.view is None:
             return 0.0
         full = floor_cells(room)
+        self.scene.furnish([room.id])  # looking into a room is what furnishes it
         boxes = self.scene.still_boxes([room.id])
         keep = np.ones(len(full), dtype=bool)
         if len(boxes):

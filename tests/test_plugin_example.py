@@ -87,5 +87,5 @@ def test_a_mission_without_the_plug_in_names_the_unknown_kind(tmp_path: Path) ->
     assert done.returncode == 2
     line = next(n for n, t in enumerate(text.splitlines(), 1) if "kind: legged" in t)
     assert done.stderr.strip() == (
-        f"error: {bare}:{line}: team[1].kind: unknown robot kind 'legged'; known: uav, ugv, "
-        "human (a plug-in adds others: plugins: [file.py])")
+        f"error: {bare}:{line}: team[1].kind: unknown robot kind 'legged'; known: 'uav', "
+        "'ugv', 'human' (a plug-in adds others: plugins: [file.py])")

@@ -98,7 +98,6 @@ def _peek(ctx: Context, robot: Robot, room: Room,
     turned = yield ctx.cosim.face(robot, into)  # turn the camera into the room
     if not turned.ok:
         raise MotionFailed(turned.reason, turned.fault)
-    ctx.sensor.scene.furnish([room.id])  # it looks in: the room's furniture is there
     coverage = ctx.sensor.coverage(robot, here[None, :], room, headings=np.array([into]))
     yield from dwell(ctx, robot, seconds)
     return distance, coverage
