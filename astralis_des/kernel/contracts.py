@@ -31,6 +31,7 @@ if TYPE_CHECKING:
 
     from astralis_des.detection import Sighting
     from astralis_des.kernel.events import EventLog, Record
+    from astralis_des.kernel.perceived import ImuTrace, KeptCloud, KeptFrame, KeptScan
     from astralis_des.kernel.robot import Motion, Robot
     from astralis_des.mission.loader import Mission
     from astralis_des.planning.navigator import Navigator
@@ -98,19 +99,19 @@ class SensorCounts(Protocol):
 
 class Perceived(Protocol):
     """What a fidelity's own sensors kept during a run: camera frames, lidar scans and
-    clouds, IMU traces per robot, and what they cost. The items are the fidelity's own
-    records (``astralis_des.physics.perception``'s), which the sinks, above it, name."""
+    clouds, IMU traces per robot (the records of :mod:`astralis_des.kernel.perceived`), and
+    what they cost."""
 
     @property
     def clock(self) -> SensorCounts: ...
     @property
-    def frames(self) -> Sequence[Any]: ...
+    def frames(self) -> Sequence[KeptFrame]: ...
     @property
-    def scans(self) -> Sequence[Any]: ...
+    def scans(self) -> Sequence[KeptScan]: ...
     @property
-    def clouds(self) -> Sequence[Any]: ...
+    def clouds(self) -> Sequence[KeptCloud]: ...
     @property
-    def imu_traces(self) -> Mapping[str, Any]: ...
+    def imu_traces(self) -> Mapping[str, ImuTrace]: ...
 
 
 @runtime_checkable

@@ -27,14 +27,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import simpy
-from numpy.typing import NDArray
 
 from astralis_des.detection import predict_pixels
+from astralis_des.kernel.perceived import ImuTrace, KeptCloud, KeptFrame, KeptScan
 from astralis_des.kernel.robot import Robot
 from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.mission.spec import CameraSpec, ImuSpec, Lidar3dSpec, LidarSpec
 from astralis_des.physics.lidar3d import Lidar3D
-from astralis_des.physics.sensors import Camera, Frame, Imu, ImuReading, Intrinsics, Lidar2D
+from astralis_des.physics.sensors import Camera, Frame, Imu, Intrinsics, Lidar2D
 from astralis_des.sensing import Sighting, in_frame
 from astralis_des.streams import stream
 from astralis_des.view import View, look_headings
@@ -68,42 +68,6 @@ class SensorClock:
         finally:
             self.seconds[name] = self.seconds.get(name, 0.0) + time.perf_counter() - t0
             self.calls[name] = self.calls.get(name, 0) + 1
-
-
-@dataclass(frozen=True)
-class KeptFrame:
-    """A camera frame kept for the recording (half resolution)."""
-
-    robot: str
-    time: float
-    rgb: NDArray[np.uint8]
-    depth: NDArray[np.uint16]  # millimetres (to 65 m); 0 where nothing was rendered
-    segmentation: NDArray[np.uint16]  # body id + 1; 0 where nothing was rendered
-    eye: FloatArray
-    rotation: FloatArray  # world_from_camera
-    intrinsics: Intrinsics
-    detection: bool
-
-
-@dataclass(frozen=True)
-class KeptScan:
-    robot: str
-    time: float
-    points: FloatArray  # (M, 3): the returns only
-
-
-@dataclass
-class KeptCloud:
-    robot: str
-    time: float
-    points: FloatArray  # (M, 3): the returns only
-    ids: NDArray[np.int32]  # (M,): the body each return hit (its segmentation id)
-
-
-@dataclass
-class ImuTrace:
-    times: list[float] = field(default_factory=list)
-    readings: list[ImuReading] = field(default_factory=list)
 
 
 class Eyes:

@@ -19,6 +19,7 @@ import numpy as np
 import pybullet as pb
 from numpy.typing import NDArray
 
+from astralis_des.kernel.perceived import ImuReading, Intrinsics
 from astralis_des.physics.client import GRAVITY, PhysicsClient, beams_near_bodies
 from astralis_des.world.geometry import FloatArray
 
@@ -42,39 +43,6 @@ def _need_rng(noise: float, rng: np.random.Generator | None, what: str) -> None:
     """Refuse noise without an explicit generator: the global RNG would break determinism."""
     if noise > 0 and rng is None:
         raise ValueError(f"{what} has noise but no rng: pass a numpy.random.Generator")
-
-
-@dataclass(frozen=True)
-class Intrinsics:
-    """A pinhole camera with square pixels; ``fov_deg`` is the vertical field of view."""
-
-    width: int
-    height: int
-    fov_deg: float
-    near: float = 0.05
-    far: float = 20.0
-
-    @property
-    def fy(self) -> float:
-        return (self.height / 2) / math.tan(math.radians(self.fov_deg) / 2)
-
-    @property
-    def fx(self) -> float:
-        return self.fy  # square pixels: PyBullet derives the horizontal fov from the aspect
-
-    @property
-    def cx(self) -> float:
-        return self.width / 2
-
-    @property
-    def cy(self) -> float:
-        return self.height / 2
-
-    def project(self, points_camera: FloatArray) -> FloatArray:
-        """``(N, 2)`` pixel coordinates ``(u, v)`` of ``(N, 3)`` points in the camera frame."""
-        p = np.atleast_2d(np.asarray(points_camera, dtype=float))
-        return np.column_stack([self.fx * p[:, 0] / p[:, 2] + self.cx,
-                                self.fy * p[:, 1] / p[:, 2] + self.cy])
 
 
 @dataclass
@@ -273,15 +241,6 @@ class Lidar2D:
                                 (centre + far[:, None] * directions).tolist())
         found = np.array([h[0] for h in hits], dtype=np.int32)
         return found, near + np.array([h[2] for h in hits]) * (far - near)
-
-
-@dataclass
-class ImuReading:
-    """Specific force (m/s²) and angular rate (rad/s), both in the body frame."""
-
-    specific_force: FloatArray
-    angular_rate: FloatArray
-    time: float = 0.0
 
 
 @dataclass

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
+    from astralis_des.kernel.perceived import KeptCloud, KeptFrame, KeptScan
     from astralis_des.simulation import Simulation
 
 Stamped = tuple[float, str, str, Any]  # (time s, topic, type name, message)
@@ -159,7 +160,7 @@ def sensors(ty: Types, sim: Simulation) -> Iterator[Stamped]:
                 linear_acceleration_covariance=np.zeros(9)))
 
 
-def _camera(ty: Types, frame: Any) -> Iterator[Stamped]:
+def _camera(ty: Types, frame: KeptFrame) -> Iterator[Stamped]:
     rid, t, k = frame.robot, frame.time, frame.intrinsics
     optical = f"{rid}/camera"
     tf = ty.geometry_msgs__TransformStamped(
@@ -184,7 +185,8 @@ def _camera(ty: Types, frame: Any) -> Iterator[Stamped]:
                                                     do_rectify=False)))
 
 
-def _scan(ty: Types, sim: Simulation, scan: Any, beams: int, reach: float) -> Iterator[Stamped]:
+def _scan(ty: Types, sim: Simulation, scan: KeptScan, beams: int,
+          reach: float) -> Iterator[Stamped]:
     """A scan's returns as ranges by bearing (``inf``: no return), from where the robot was."""
     robot = sim.robots[scan.robot]
     times = np.asarray(robot.trail_t, dtype=float)
@@ -257,7 +259,7 @@ def pose_sensors(ty: Types, sim: Simulation) -> Iterator[Stamped]:
 INT32, FLOAT32 = 5, 7  # sensor_msgs/PointField datatypes
 
 
-def _cloud(ty: Types, cloud: Any) -> Stamped:
+def _cloud(ty: Types, cloud: KeptCloud) -> Stamped:
     """A kept 3-D lidar sweep as a PointCloud2 in ``map``: x, y, z (float32) and the id of
     the body each return hit (int32, its segmentation id)."""
     n = len(cloud.points)

@@ -17,8 +17,8 @@ from astralis_des.sinks.looks import by_height
 
 if TYPE_CHECKING:
     from astralis_des.kernel.contracts import Perceived
+    from astralis_des.kernel.perceived import KeptCloud, KeptFrame, KeptScan
     from astralis_des.navsensors import PoseSensors
-    from astralis_des.physics.perception import KeptCloud, KeptFrame, KeptScan
 
 Kept = TypeVar("Kept", "KeptFrame", "KeptScan", "KeptCloud")
 
