@@ -219,7 +219,7 @@ def test_a_query_never_furnishes_a_room(world: World) -> None:
     told: list[str] = []
     scene = Scene(world, dict.fromkeys(world.rooms, 1.0), 3, default_catalogue())
     scene.listeners.append(lambda room, clutter: told.append(room))
-    with pytest.raises(LookupError, match="room A.2.1.2 is not furnished yet"):
+    with pytest.raises(LookupError, match=r"room A\.2\.1\.2 is not furnished yet"):
         scene.clutter("A.2.1.2")
     with pytest.raises(LookupError):
         scene.still_boxes(["A.2.1.2"])
