@@ -29,7 +29,7 @@ def add_walker(sim: Simulation, ends: list[tuple[float, float]], offset: float =
     loop = np.array([[*ends[0], 0.86], [*ends[1], 0.86], [*ends[0], 0.86]])
     walker = Mover("avatar:walker", "avatar", loop, 0.6, (0.5, 0.5, 1.72), offset=offset)
     sim.scene.movers.append(walker)
-    sim.cosim._add_movers([walker])
+    sim.cosim.bodies.add_movers([walker])
 
 
 def contacts_between(sim: Simulation, a: str, b: str) -> list[dict]:

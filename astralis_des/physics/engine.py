@@ -26,10 +26,13 @@ class Engine(Protocol):
     robots: dict[str, Robot]
     drivers: dict[str, Driver]
     active: dict[str, tuple[Robot, Any, Any]]  # robot id -> (robot, its track, done event)
-    movers: list[tuple[Mover, int]]  # scripted movers and their bodies
     lifts: list[Lift]
     period: float  # s: one control period
-    t: float  # physics time: whole control periods
+
+    @property
+    def movers(self) -> list[tuple[Mover, int]]: ...  # scripted movers and their bodies
+    @property
+    def t(self) -> float: ...  # physics time: whole control periods
 
     def fits(self, rid: str, points: FloatArray) -> np.ndarray: ...
     def stands(self, rid: str, points: FloatArray) -> np.ndarray: ...
