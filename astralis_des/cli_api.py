@@ -66,7 +66,7 @@ def add_api_parsers(sub: Any, add_mission_options: Callable[[Any], None]) -> Non
                        help="robot states published per simulated second (default 10)")
     serve.add_argument("--exit-on-end", action="store_true",
                        help="stop when the mission ends (default: keep answering queries)")
-    serve.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    serve.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     _add_clock_options(serve)
     add_mission_options(serve)
     keys = sub.add_parser("keys", help="make CURVE keys for serving beyond this machine")

@@ -8,6 +8,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -280,3 +281,116 @@ def test_world_rooms_lists_what_a_mission_can_name() -> None:
                            "66,", "79.5,", "0", "A.1.corridor"]
     assert sum(line.startswith("A.2.1.") for line in out.splitlines()) == 3
     assert len(out.splitlines()) == 2 + 24
+
+
+# -- the same options everywhere ---------------------------------------------------------------
+COMMANDS = ["run", "replay", "export", "validate", "world", "study", "tune", "serve", "keys",
+            "chat", "teleop", "schema"]
+WORLD_COMMANDS = ["rooms", "spots", "show", "import"]
+WRITERS = [["run"], ["study"], ["tune"], ["serve"], ["chat"], ["schema"], ["world", "show"],
+           ["world", "import"]]
+
+
+def help_text(capsys: pytest.CaptureFixture[str], *command: str) -> str:
+    with pytest.raises(SystemExit) as exc:
+        main([*command, "--help"])
+    assert exc.value.code == 0
+    return capsys.readouterr().out
+
+
+def test_the_help_lists_every_command(capsys: pytest.CaptureFixture[str]) -> None:
+    """The commands the tests below go through are all there are."""
+    listed = re.findall(r"^    (\w+) ", help_text(capsys), flags=re.MULTILINE)
+    assert listed == COMMANDS
+    listed = re.findall(r"^    (\w+) ", help_text(capsys, "world"), flags=re.MULTILINE)
+    assert listed == WORLD_COMMANDS
+
+
+def test_every_command_spells_its_options_the_same(capsys: pytest.CaptureFixture[str]) -> None:
+    """What a command writes goes to -o/--out, --output shown nowhere; every --quiet is also
+    -q; the top level has -V/--version."""
+    for command in [[c] for c in COMMANDS] + [["world", w] for w in WORLD_COMMANDS]:
+        text = help_text(capsys, *command)
+        writes = re.search(r"^  -o (DIR|FILE), --out (DIR|FILE) ", text, flags=re.MULTILINE)
+        assert bool(writes) is (command in WRITERS), command
+        assert "--output" not in text, command
+        assert ("--quiet" in text) is ("-q, --quiet" in text), command
+    assert "-V, --version" in help_text(capsys)
+
+
+def test_short_options(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``-V`` prints the version; ``run -q -o DIR`` writes the run and prints nothing."""
+    assert main(["-V"]) == 0
+    assert capsys.readouterr().out == f"astralis-des {astralis_des.__version__}\n"
+    assert main(["run", str(MISSION), "-q", "-o", str(tmp_path / "run"), "--no-recording"]) == 0
+    assert capsys.readouterr() == ("", "")
+    assert sorted(p.name for p in (tmp_path / "run").iterdir()) == ["events.jsonl",
+                                                                     "summary.json"]
+
+
+def test_the_old_output_spelling_still_works(tmp_path: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    """Scripts written for ``--output`` (schema, world show, world import) keep working."""
+    target = tmp_path / "world.schema.json"
+    assert main(["schema", "--world", "--output", str(target)]) == 0
+    assert "buildings" in json.loads(target.read_text(encoding="utf-8"))["properties"]
+    code, _, err = run_cli("world", "import", str(tmp_path / "scan.las"), "--output",
+                           str(tmp_path / "w.yaml"))  # past argparse: the file is missing
+    assert code == 2 and err.startswith(f"error: {tmp_path / 'scan.las'}"), err
+    with pytest.raises(SystemExit) as exc:
+        main(["world", "import", str(tmp_path / "scan.las")])
+    assert exc.value.code == 2
+    assert capsys.readouterr().err.splitlines()[-1] == (
+        "astralis world import: error: the following arguments are required: -o/--out")
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="X11 or Wayland: Linux")
+def test_the_viewer_without_a_display_says_to_use_web(
+        quiet_run: tuple[Path, int, str, str], tmp_path: Path,
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """``replay`` (and ``run --view``) with no DISPLAY nor WAYLAND_DISPLAY: exit 2 and one
+    line naming --web, before any viewer starts (before: a winit error from the viewer)."""
+    import astralis_des.sinks.viewer as viewer
+
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setattr(viewer.subprocess, "call", lambda *a, **k: pytest.fail("spawned"))
+    recording = quiet_run[0] / "recording.rrd"
+    code, out, err = run_cli("replay", str(recording))
+    assert (code, out) == (2, "")
+    assert err == ("error: no display to open the Rerun viewer on (DISPLAY and WAYLAND_DISPLAY "
+                   "are not set); use --web to serve it to a browser: astralis replay "
+                   f"{recording} --web\n")
+    code, out, err = run_cli("run", str(MISSION), "--view", "-o", str(tmp_path / "run"))
+    assert (code, out, len(err.splitlines())) == (2, "", 1)
+    assert "--web" in err and not (tmp_path / "run").exists()
+
+
+def test_stdout_holds_only_our_lines_with_pybullet(tmp_path: Path) -> None:
+    """A physics run and a world import with V-HACD parts load PyBullet, which prints its
+    build time and its progress: none of it reaches stdout (a pipe: C buffers it to the end)."""
+    import trimesh
+
+    short = tmp_path / "short.yaml"
+    short.write_text(MISSION.read_text().replace("../worlds/", f"{WORLD.parent}/")
+                     .replace("time_limit: 3600", "time_limit: 10"), encoding="utf-8")
+    trimesh.util.concatenate([trimesh.creation.box((10, 10, 3)).apply_translation((0, 0, 1.5)),
+                              trimesh.creation.box((4, 4, 6)).apply_translation((12, 0, 3))]
+                             ).export(tmp_path / "blocks.obj")
+    cli = [sys.executable, "-m", "astralis_des.cli"]
+    env = {**os.environ, "COLUMNS": "100"}
+    run = subprocess.run([*cli, "run", str(short), "--fidelity", "physics", "--no-recording",
+                          "-o", str(tmp_path / "run")], capture_output=True, text=True,
+                         timeout=300, env=env)
+    imp = subprocess.run([*cli, "world", "import", str(tmp_path / "blocks.obj"), "-o",
+                          str(tmp_path / "w" / "blocks.yaml"), "--collision", "convex", "--up",
+                          "z"], capture_output=True, text=True, timeout=300, env=env)
+    assert run.returncode == 0 and imp.returncode == 0, run.stderr + imp.stderr
+    lines = run.stdout.splitlines()
+    assert lines[0].startswith("urban_search (seed 42, physics): ")
+    assert lines[-1] == f"outputs: {tmp_path / 'run'}/"
+    lines = imp.stdout.splitlines()
+    assert lines[0].startswith(f"{tmp_path / 'w' / 'blocks.yaml'}: 24 triangles, ")
+    assert lines[-1] == "wrote blocks.blocks.npz, blocks.mesh.obj, blocks.parts.obj, blocks.yaml"
+    for text in (run.stdout, imp.stdout):
+        assert "pybullet" not in text.lower() and "build time" not in text

@@ -148,6 +148,7 @@ def test_replay_opens_the_viewer_on_a_recording(faults_run: tuple[RunResult, Pat
     """On a recording, replay runs the rerun viewer on it and returns its exit code."""
     _, rrd = faults_run
     calls: list[list[str]] = []
+    monkeypatch.setenv("DISPLAY", ":0")  # a desktop's (tests/test_cli.py: one without)
     monkeypatch.setattr(subprocess, "call", lambda cmd: calls.append(cmd) or 0)
     assert main(["replay", str(rrd)]) == 0
     assert calls and calls[0][0].endswith("rerun") and calls[0][-1] == str(rrd)
@@ -158,6 +159,7 @@ def test_view_streams_to_a_viewer_as_the_run_goes(tmp_path: Path,
     """--view connects a viewer and sends the event log in pieces during the run, and the
     file still gets all of it."""
     connected: list[Path] = []
+    monkeypatch.setenv("DISPLAY", ":0")  # a desktop's (tests/test_cli.py: one without)
     monkeypatch.setattr(recording_module.RerunRecorder, "connect_viewer",
                         lambda self, path: connected.append(path))
     assert main(["run", str(ROOT / "missions" / "fig7.yaml"), "--out", str(tmp_path),

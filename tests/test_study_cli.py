@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import re
 from pathlib import Path
 
 import pyarrow.parquet as pq
@@ -12,6 +13,10 @@ import pytest
 
 import astralis_des
 from astralis_des.cli import main
+from astralis_des.studies import load_study
+from astralis_des.studies.eval_mission import METRICS
+from astralis_des.studies.reports import headline
+from astralis_des.studies.results import StudyResult
 
 ROOT = Path(__file__).parents[1]
 TABLE5 = ROOT / "studies" / "table5.yaml"
@@ -103,3 +108,47 @@ def test_help_lists_study() -> None:
         run_cli("--help")
     code, stdout, _ = run_cli()
     assert code == 0 and "study" in stdout
+
+
+OUTCOMES = ROOT / "studies" / "outcomes.yaml"
+
+
+@pytest.mark.parametrize("width", [100, 80])
+def test_the_summary_fits_the_terminal(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                       width: int) -> None:
+    """A mission study has 14 metrics: the terminal gets the headline (found, time to find
+    with its median and quartiles) within its width, no value cut to "…", and a line naming
+    the files with the rest; report.md has every metric. (Before: 17 columns of "…".)"""
+    monkeypatch.setenv("COLUMNS", str(width))
+    out = tmp_path / "outcomes"
+    code, stdout, stderr = run_cli("study", str(OUTCOMES), "--scenarios", "3", "--workers",
+                                   "1", "--out", str(out))
+    assert code == 0, stderr
+    lines = stdout.splitlines()
+    assert max(len(line) for line in lines) <= width
+    assert "…" not in stdout and "..." not in stdout
+    assert [v for v in ("naive", "mixed", "greedy") if re.search(rf"│ {v} +│", stdout)] == [
+        "naive", "mixed", "greedy"]
+    for word in ("variant", "runs", "found", "time", "mean", "median", "[IQR]"):
+        assert f" {word} " in stdout, word  # headers wrap at words, as the width allows
+    assert re.search(r"│ +\d+\.\d% ", stdout)  # a share, whole
+    assert "9 runs in " in stdout
+    assert lines[-1] == "also there: report.md (every metric), table.csv (every run)"
+    report = (out / "report.md").read_text()
+    for metric in METRICS:
+        assert f"| {metric.label} |" in report, metric.label
+    assert "| time to find, median [IQR] |" in report
+
+
+def test_a_failed_run_shows_in_the_headline(tmp_path: Path) -> None:
+    """The headline counts failed runs only when there are some."""
+    study = load_study(OUTCOMES).with_changes(scenarios=2)
+    rows = [{"scenario": 0, "seed": 1, "variant": "naive", "status": "failed", "error": "x"}]
+    rows += [{"scenario": i, "seed": i, "variant": v, "status": "ok", "found": True,
+              "time_to_find": 10.0 * (i + 1)} for i in range(2) for v in ("mixed", "greedy")]
+    table = headline(StudyResult(study, rows))
+    assert table.headers[:3] == ["variant", "runs", "failed"]
+    assert [row[:3] for row in table.rows] == [["naive", "1", "1"], ["mixed", "2", "0"],
+                                               ["greedy", "2", "0"]]
+    assert table.rows[1][-1] == "15.0 s [12.5, 17.5]"  # median [first, third quartile]
+    assert table.rows[0][3:] == ["-", "-", "-"]

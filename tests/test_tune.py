@@ -169,3 +169,32 @@ def test_bad_tune_files_are_one_line_and_write_nothing(
 def test_each_tune_file_of_the_repository_loads(path: Path) -> None:
     tune = load_tune(path)
     assert tune.metrics() and tune.spec.trials >= 1
+
+
+SIX = {f"w{w}.{kind}": {"low": 0, "high": 10} for w in (1, 2) for kind in ("human", "uav", "ugv")}
+
+
+@pytest.mark.parametrize("width", [100, 80])
+@pytest.mark.parametrize("aim", ["front", "targets"])
+def test_the_report_fits_the_terminal(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                      monkeypatch: pytest.MonkeyPatch, width: int,
+                                      aim: str) -> None:
+    """Six weights: the front (a column each, and the two aims) or the best trial's tables
+    within the terminal's width, no value cut to "…"; then where the files are."""
+    monkeypatch.setenv("COLUMNS", str(width))
+    goal: dict[str, object] = (
+        {"objectives": [{"metric": "mixed.ugv_high_mess"}, {"metric": "mixed.human_high_risk"}]}
+        if aim == "front" else {"targets": {"mixed.ugv_high_mess": 0.06}})
+    path = write(tmp_path, {"seed": 1, "trials": 4, "sampler": "random", "params": SIX,
+                            **goal})
+    assert main(["tune", str(path), "-o", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert max(len(line) for line in out.splitlines()) <= width
+    assert "…" not in out
+    best = json.loads((tmp_path / "out" / "best.json").read_text())
+    shown = [f"param.{p}" for p in SIX] + ["mixed.ugv_high_mess"]
+    for row in best:  # every weight and figure of the best trial (or the front), whole
+        for key in shown:
+            assert f" {row[key]:.4g} " in out, key
+    assert out.splitlines()[-1] == ("also there: report.md (this report), trials.csv (every "
+                                    "trial), plots/")

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 
 from astralis_des.errors import InputError
@@ -33,6 +35,23 @@ def viewer_command(path: Path, web: bool = False) -> list[str]:
     return [exe, *(["--web-viewer"] if web else []), str(path)]
 
 
+def no_display(environ: Mapping[str, str] = os.environ, platform: str = sys.platform) -> bool:
+    """Whether the native viewer has nowhere to open: Linux without an X11 or Wayland
+    display (a server, a container, ssh without -X)."""
+    return platform.startswith("linux") and not (environ.get("DISPLAY")
+                                                 or environ.get("WAYLAND_DISPLAY"))
+
+
+def require_display(instead: str) -> None:
+    """Refuse in one line, before the viewer fails in its own words, saying what to do
+    ``instead``."""
+    if no_display():
+        raise InputError(f"no display to open the Rerun viewer on (DISPLAY and "
+                         f"WAYLAND_DISPLAY are not set); {instead}")
+
+
 def open_viewer(path: Path, web: bool = False) -> int:
     check_recording(path)
+    if not web:
+        require_display(f"use --web to serve it to a browser: astralis replay {path} --web")
     return subprocess.call(viewer_command(path, web))

@@ -14,9 +14,10 @@ from astralis_des.errors import InputError
 from astralis_des.exits import EXIT_INTERRUPTED
 from astralis_des.outdir import holding
 from astralis_des.studies.backends import make_backend
-from astralis_des.studies.reports import TextTable, report
+from astralis_des.studies.reports import report
 from astralis_des.studies.runner import run_scenario, run_study
 from astralis_des.studies.spec import Study, load_study
+from astralis_des.studies.terminal import fitted
 
 EXIT_FAILED = 1
 
@@ -52,10 +53,13 @@ def study_command(args: argparse.Namespace) -> int:
     if not args.quiet:
         stdout = Console()
         for table in report(result):
-            stdout.print(_rich(table))
+            if table.shown:
+                for part in fitted(table, stdout.width):
+                    stdout.print(part)
         stdout.print(f"{len(result.rows):,} runs in {result.wall_time:.1f} s "
                      f"({result.backend}, {result.workers} worker"
                      f"{'s' if result.workers > 1 else ''}); outputs: {out}/")
+        stdout.print("also there: report.md (every metric), table.csv (every run)")
     if result.failed:
         first = next(r for r in result.rows if r["status"] == "failed")
         console.print(f"[red]{result.failed} failed run(s)[/] (tracebacks in "
@@ -97,15 +101,6 @@ def _cell(value: Any) -> str:
     if isinstance(value, float):
         return f"{value:.4g}"
     return "" if value is None else str(value)
-
-
-def _rich(table: TextTable) -> Table:
-    out = Table(title=table.title, caption=" ".join(table.notes) or None)
-    for i, header in enumerate(table.headers):
-        out.add_column(header, justify="left" if i < 2 else "right")
-    for row in table.rows:
-        out.add_row(*row)
-    return out
 
 
 def with_progress(console: Console, name: str, unit: str, total: int, run: Any) -> Any:

@@ -27,7 +27,8 @@ METRICS = (
 )
 
 
-@evaluation("assignment", METRICS, tradeoff=("human_high_risk", "ugv_high_mess"))
+@evaluation("assignment", METRICS, tradeoff=("human_high_risk", "ugv_high_mess"),
+            headline=("human_high_risk", "ugv_high_mess"))
 def evaluate_assignment(study: Study, scenario: Scenario, variant: Variant,
                         out_dir: Path | None) -> dict[str, Any]:
     s = variant.setting

@@ -78,7 +78,8 @@ def scenario_mission(study: Study, scenario: Scenario, s: Setting, outputs: bool
         **changes)
 
 
-@evaluation("mission", METRICS, tradeoff=("human_high_risk_s", "ugv_high_mess_s"))
+@evaluation("mission", METRICS, tradeoff=("human_high_risk_s", "ugv_high_mess_s"),
+            headline=("found", "time_to_find"))
 def evaluate_mission(study: Study, scenario: Scenario, variant: Variant,
                      out_dir: Path | None) -> dict[str, Any]:
     from astralis_des.simulation import Simulation

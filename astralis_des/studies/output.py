@@ -2,7 +2,7 @@
 
     table.csv  table.parquet   one row per scenario and variant
     summary.csv                per variant and metric, with 95% intervals
-    report.md                  what the CLI prints
+    report.md                  the headline the CLI prints, then every metric
     plots/*.png  plots/*.svg
     study.yaml                 the study file as run
     meta.json                  package version, seed, scenarios, backend, workers, wall time

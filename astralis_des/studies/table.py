@@ -68,6 +68,23 @@ def mean_ci(values: Sequence[float], level: float = 0.95) -> tuple[float, float,
     return (mean, mean - half, mean + half)
 
 
+def quartiles(values: Sequence[float]) -> tuple[float, float, float]:
+    """The first quartile, the median and the third quartile (NaN without values)."""
+    if not len(values):
+        return (math.nan, math.nan, math.nan)
+    q1, median, q3 = np.percentile(np.asarray(values, dtype=float), [25, 50, 75])
+    return (float(q1), float(median), float(q3))
+
+
+def metric_values(data: dict[str, list[Any]], column: str, variant: str) -> list[Any]:
+    """A metric's values over a variant's runs that ended ``ok`` and have it (time to find:
+    the runs that found the target), in row order; ``data``: the table as columns."""
+    if column not in data:
+        return []
+    return [data[column][i] for i, v in enumerate(data.get("variant", []))
+            if v == variant and data["status"][i] == "ok" and data[column][i] is not None]
+
+
 def summarize(table: pa.Table, metrics: Sequence[Metric],
               variants: Sequence[str]) -> list[dict[str, Any]]:
     """Per variant and metric (tidy): ``n`` scenarios that ran, the estimate, its 95% bounds.
@@ -90,6 +107,14 @@ def summarize(table: pa.Table, metrics: Sequence[Metric],
                         "kind": metric.kind, "unit": metric.unit, "n": len(values),
                         "failed": len(mine) - len(ok), "estimate": est, "low": lo, "high": hi})
     return out
+
+
+def format_quartiles(values: Sequence[float], unit: str = "") -> str:
+    """``170.2 s [121.0, 240.2]``: the median and the interquartile range."""
+    q1, median, q3 = quartiles(values)
+    if math.isnan(median):
+        return "-"
+    return f"{median:.1f}{f' {unit}' if unit else ''} [{q1:.1f}, {q3:.1f}]"
 
 
 def format_estimate(entry: dict[str, Any]) -> str:

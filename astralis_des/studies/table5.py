@@ -81,5 +81,5 @@ def table5_report(result: StudyResult) -> list[TextTable]:
         "Table V: results for randomly initialized assignments",
         ["", "variant", "ours, 95% CI", "paper", "within sampling error"], rows,
         notes=["Shares of all scenarios; 'within sampling error' is a two-proportion z-test "
-               f"against the paper's {PAPER_N:,} scenarios at 95%."])
+               f"against the paper's {PAPER_N:,} scenarios at 95%."], keys=2)
     return [table, *summary_report(result)]

@@ -14,6 +14,7 @@ from astralis_des.exits import EXIT_INTERRUPTED
 from astralis_des.outdir import Staging
 from astralis_des.studies.backends import make_backend
 from astralis_des.studies.console import with_progress
+from astralis_des.studies.terminal import fitted
 from astralis_des.studies.tune import run_tune
 from astralis_des.studies.tune_output import JOURNAL, TUNE_FILES, report
 from astralis_des.studies.tune_spec import Tune, load_tune
@@ -46,8 +47,16 @@ def tune_command(args: argparse.Namespace) -> int:
                       "--resume)")
         return EXIT_INTERRUPTED
     if not args.quiet:
-        Console().print(Markdown("\n".join(report(result))))
-        Console().print(f"{len(result.rows)} trials; outputs: {out}/")
+        stdout = Console()
+        for block in report(result):
+            if isinstance(block, str):
+                stdout.print(Markdown(block))
+            else:
+                for table in fitted(block, stdout.width):
+                    stdout.print(table)
+            stdout.print()
+        stdout.print(f"{len(result.rows)} trials; outputs: {out}/")
+        stdout.print("also there: report.md (this report), trials.csv (every trial), plots/")
     return 0
 
 

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from astralis_des.outdir import dumps, finite, result_files, write_file
+from astralis_des.studies.reports import TextTable
 from astralis_des.studies.table import Z95, write_table
 from astralis_des.studies.tune_spec import Tune
 
@@ -49,7 +50,7 @@ def write_tune(result: TuneResult, folder: Path) -> None:
         table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in result.rows])
         write_table(table, folder, "trials")
     write_file(folder / "best.json", dumps(finite(result.best), indent=2) + "\n")
-    write_file(folder / "report.md", "\n".join(report(result)) + "\n")
+    write_file(folder / "report.md", report_markdown(result))
     write_file(folder / "tune.yaml", result.tune.text)
     meta = {"astralis_des": __version__, "tune": result.tune.name, "seed": result.tune.spec.seed,
             "sampler": result.tune.spec.sampler, "trials": len(result.rows),
@@ -67,48 +68,65 @@ def _fmt(value: Any) -> str:
     return str(value)
 
 
-def report(result: TuneResult) -> list[str]:
-    """The report's lines (Markdown): what was searched, the best (or the front), the fit."""
+Block = str | TextTable  # a paragraph or heading (Markdown), or a table
+
+
+def report_markdown(result: TuneResult) -> str:
+    """``report.md``: the report's blocks, a blank line between them."""
+    return "\n".join(b if isinstance(b, str) else b.markdown() for b in
+                     _spaced(report(result)))
+
+
+def _spaced(blocks: list[Block]) -> list[Block]:
+    out: list[Block] = []
+    for block in blocks:
+        out += [block, ""] if isinstance(block, str) else [block]
+    return out
+
+
+def report(result: TuneResult) -> list[Block]:
+    """The report: what was searched, the best (or the front), the fit."""
     spec = result.tune.spec
     params = list(spec.params)
     ok = [r for r in result.rows if r["state"] == "ok"]
-    lines = [f"# Tune {spec.name}", "",
-             f"{len(result.rows)} of {spec.trials} trials ({spec.sampler}, seed {spec.seed}), "
-             f"{result.tune.study.scenarios:,} scenarios a trial"
-             + ("; interrupted" if result.interrupted else "") + ".", ""]
+    blocks: list[Block] = [
+        f"# Tune {spec.name}",
+        f"{len(result.rows)} of {spec.trials} trials ({spec.sampler}, seed {spec.seed}), "
+        f"{result.tune.study.scenarios:,} scenarios a trial"
+        + ("; interrupted" if result.interrupted else "") + "."]
     if not result.best:
-        return [*lines, "No trial ran to the end."]
+        return [*blocks, "No trial ran to the end."]
     if spec.targets:
         best = result.best[0]
-        lines += ["## Best trial", "", f"Trial {best['trial']}: largest |z| "
-                  f"{_fmt(best['score'])}.", "",
-                  "| parameter | value |", "| --- | --- |",
-                  *(f"| {p} | {_fmt(best[f'param.{p}'])} |" for p in params), "",
-                  "| target | ours | wanted | z |", "| --- | --- | --- | --- |",
-                  *(f"| {m} | {_fmt(best[m])} | {_fmt(t.value)} | {best[f'z.{m}']:+.2f} |"
-                    for m, t in result.tune.targets().items()), ""]
+        blocks += ["## Best trial", f"Trial {best['trial']}: largest |z| {_fmt(best['score'])}.",
+                   TextTable("", ["parameter", "value"],
+                             [[p, _fmt(best[f"param.{p}"])] for p in params]),
+                   TextTable("", ["target", "ours", "wanted", "z"],
+                             [[m, _fmt(best[m]), _fmt(t.value), f"{best[f'z.{m}']:+.2f}"]
+                              for m, t in result.tune.targets().items()])]
         fits = result.fits()
-        lines += ["## The weights that fit", "",
-                  f"{len(fits)} of {len(ok)} trials reproduce every target within sampling "
-                  f"error (|z| <= {Z95:.2f}) and meet the constraints."]
+        blocks += ["## The weights that fit",
+                   f"{len(fits)} of {len(ok)} trials reproduce every target within sampling "
+                   f"error (|z| <= {Z95:.2f}) and meet the constraints."
+                   + (" Over them, each parameter ranges:" if fits else "")]
         if fits:
-            lines += ["Over them, each parameter ranges:", "", "| parameter | min | max |",
-                      "| --- | --- | --- |"]
-            for p in params:
-                values = [r[f"param.{p}"] for r in fits]
-                if all(isinstance(v, int | float) for v in values):
-                    lines.append(f"| {p} | {_fmt(min(values))} | {_fmt(max(values))} |")
-                else:
-                    lines.append(f"| {p} | {', '.join(sorted(set(map(str, values))))} | |")
-        return lines
+            blocks.append(TextTable("", ["parameter", "min", "max"],
+                                    [_range(p, [r[f"param.{p}"] for r in fits])
+                                     for p in params]))
+        return blocks
     aims = [o.metric for o in spec.objectives]
-    lines += ["## Front" if len(aims) > 1 else "## Best trial", "",
-              "| trial | " + " | ".join([*params, *aims]) + " |",
-              "| --- " * (1 + len(params) + len(aims)) + "|"]
-    lines += [f"| {r['trial']} | " + " | ".join(_fmt(r[k]) for k in
-                                                [*(f"param.{p}" for p in params), *aims]) + " |"
-              for r in result.best]
-    return lines
+    return [*blocks, "## Front" if len(aims) > 1 else "## Best trial",
+            TextTable("", ["trial", *params, *aims],
+                      [[str(r["trial"]), *(_fmt(r[k]) for k in
+                                           [*(f"param.{p}" for p in params), *aims])]
+                       for r in result.best])]
+
+
+def _range(param: str, values: list[Any]) -> list[str]:
+    """A parameter's least and greatest value over trials; a category's values, in order."""
+    if all(isinstance(v, int | float) for v in values):
+        return [param, _fmt(min(values)), _fmt(max(values))]
+    return [param, ", ".join(sorted(set(map(str, values)))), ""]
 
 
 def write_plots(result: TuneResult, folder: Path) -> None:

@@ -1,0 +1,111 @@
+"""``astralis run``: run a mission file under a progress bar, then print its summary."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from astralis_des.exits import EXIT_INTERRUPTED
+
+if TYPE_CHECKING:
+    from astralis_des.simulation.result import RunResult
+
+
+def run_command(args: argparse.Namespace) -> int:
+    """``astralis run MISSION``: a progress bar on stderr, then a summary on stdout."""
+    from rich.console import Console
+
+    from astralis_des.mission.overrides import mission_from_args
+    from astralis_des.outdir import holding
+    from astralis_des.simulation import Simulation
+
+    mission, out = mission_from_args(args)
+    if args.view:
+        from astralis_des.sinks.viewer import require_display
+
+        require_display(f"run without --view, then: astralis replay {out}/recording.rrd --web")
+    if mission.spec.outputs.mcap:
+        from astralis_des.sinks.mcap_out import require
+
+        require()
+    console = Console(stderr=True, quiet=args.quiet, soft_wrap=True)  # never wrapped
+    made: list[Simulation] = []
+
+    def run(progress: Any) -> RunResult:
+        made.append(Simulation(mission, out_dir=out, progress=progress, view=args.view))
+        return made[0].run()
+
+    try:
+        with holding(out):  # a second writer is refused before the world is built
+            result = _with_progress(console, mission.spec.time_limit, run)
+    except KeyboardInterrupt:
+        recorded = bool(made) and made[0].started
+        console.print("[yellow]interrupted[/]; " + (f"what was recorded is in {out}/"
+                                                     if recorded else "nothing written"))
+        return EXIT_INTERRUPTED
+    if not args.quiet:
+        _print_summary(Console(), result, out)
+    return 0
+
+
+def _with_progress(console: Any, limit: float, run: Callable[[Any], RunResult]) -> RunResult:
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    columns = (TextColumn("[bold]mission"), BarColumn(),
+               TextColumn("sim {task.completed:>7.1f} s of {task.total:.0f} s"),
+               TimeElapsedColumn())
+    with Progress(*columns, console=console, transient=False) as bar:
+        task = bar.add_task("mission", total=limit)
+        last = [0.0]
+
+        def advance(now: float, _limit: float) -> None:
+            if now - last[0] >= limit / 200:
+                last[0] = now
+                bar.update(task, completed=now)
+
+        result = run(advance)
+        bar.update(task, total=result.end_time, completed=result.end_time)
+    return result
+
+
+def _print_summary(console: Any, result: RunResult, out: Path) -> None:
+    from rich.table import Table
+
+    found = (f"found by {result.found_by} at t = {result.time_to_find:.1f} s"
+             if result.found else result.outcome.replace("_", " "))
+    console.print(f"[bold]{result.mission}[/] (seed {result.seed}, {result.fidelity}): {found}; "
+                  f"target in {result.target['room']}; {len(result.rounds)} assignment rounds, "
+                  f"{len(result.rooms_searched)} rooms searched; "
+                  f"{result.end_time:.1f} s simulated in {result.wall_time:.2f} s")
+    table = Table(title="team")
+    table.add_column("robot", no_wrap=True)
+    for header in ("kind", "dist m", "busy s", "idle s", "ok", "failed", "cancel", "preempt"):
+        table.add_column(header, justify="right" if header != "kind" else "left")
+    for rid, s in result.robots.items():
+        table.add_row(rid, s.kind, f"{s.distance:.1f}", f"{s.busy_time:.1f}",
+                      f"{s.idle_time:.1f}", str(s.tasks_succeeded), str(s.tasks_failed),
+                      str(s.tasks_cancelled), str(s.tasks_preempted))
+    console.print(table)
+    if not result.found:
+        _print_rooms(console, result)
+    console.print(f"outputs: {out}/")
+
+
+def _print_rooms(console: Any, result: RunResult) -> None:
+    """Per room, what was seen of it and by whom: "hidden by furniture" is not "never looked"."""
+    from rich.table import Table
+
+    table = Table(title="rooms")
+    for header in ("room", "status", "seen", "searches"):
+        table.add_column(header, justify="right" if header == "seen" else "left")
+    for room, entry in result.rooms.items():
+        seen = "-" if entry["coverage"] is None else f"{entry['coverage']:.0%}"
+        searches = ", ".join(
+            f"{s['robot']} {s['action']} {s['status']}"
+            + ("" if s["coverage"] is None else f" {s['coverage']:.0%}")
+            for s in entry["searches"])
+        mark = " (target)" if room == result.target["room"] else ""
+        table.add_row(room + mark, entry["status"].replace("_", " "), seen, searches or "-")
+    console.print(table)
