@@ -19,8 +19,11 @@ from astralis_des.assignment.plans import Plan, Problem
 from astralis_des.assignment.strategies import register_planner
 
 
-@register_planner("auction", whole_mission=True)
+@register_planner("auction", whole_mission=True, options=("bid",))
 def auction(problem: Problem) -> Plan:
+    """Sequential single-item auction over every pending room of the mission: the lowest bid
+    (what the room adds to a queue, or with ``bid: finish`` the queue's finish time) wins,
+    room after room."""
     n_a, n_r = problem.allowed.shape
     finish = problem.options.get("bid", "marginal") == "finish"
     queues: list[list[int]] = [[] for _ in range(n_a)]

@@ -36,7 +36,9 @@ def _matching(costs: np.ndarray, allowed: np.ndarray) -> list[list[int]]:
 
 @register_planner("hard")
 def hard(problem: Problem) -> Plan:
-    """Eq. 1's distance under hard constraints (the weights' intent, as rules)."""
+    """Eq. 1's distance under hard constraints, the weights' intent as rules: each kind is kept
+    out of the rooms high in its hazard (a person: risk >= ``high_risk``; the UGV: messiness
+    >= ``high_messiness``); a round they make infeasible is reported."""
     risk = np.array([r.risk for r in problem.rooms])
     mess = np.array([r.messiness for r in problem.rooms])
     kinds = [a.kind for a in problem.agents]

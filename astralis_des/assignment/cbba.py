@@ -245,8 +245,10 @@ TABLE_1: dict[tuple[str, str], Rule] = {
 }
 
 
-@register_planner("cbba", whole_mission=True)
+@register_planner("cbba", whole_mission=True, options=("bundle", "comm_range", "discount"))
 def cbba(problem: Problem) -> Plan:
+    """The consensus-based bundle algorithm over every pending room of the mission: bundles of
+    up to ``bundle`` rooms, a time-discounted reward, agents within ``comm_range`` talking."""
     run = CBBA(problem)
     converged = run.run()
     owner: dict[int, int] = {}

@@ -190,8 +190,10 @@ def _options(problem: Problem) -> dict[str, Any]:
             "mip_rel_gap": float(problem.options.get("mip_gap", 0.01)), "disp": False}
 
 
-@register_planner("milp", whole_mission=True)
+@register_planner("milp", whole_mission=True, options=("objective", "time_limit", "mip_gap"))
 def milp_plan(problem: Problem) -> Plan:
+    """A mixed-integer program over every pending room of the mission (HiGHS): the makespan or
+    the sum of completion times, to ``mip_gap`` or ``time_limit``."""
     objective = str(problem.options.get("objective", "makespan"))
     search, first, hop = problem.search_times, problem.first_legs, _hops(problem)
     if objective == "sum":

@@ -5,6 +5,7 @@ queues (``auction``, ``cbba``, ``milp``) or match under other rules (``hard``, `
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -54,12 +55,20 @@ Costs = Callable[[Sequence[Agent], Sequence[RoomInfo], Weights], NDArray[np.floa
 class Strategy:
     """A cost matrix and the matcher that pairs on it (None: the mission's solver), or a
     planner of whole queues; ``whole_mission``: it is given every pending room of the mission
-    at once, not a segment's."""
+    at once, not a segment's; ``options``: the keys of the mission's ``assignment.options``
+    it reads (``docs/missions.md`` lists them per strategy)."""
 
     costs: Costs | None = None
     matcher: str | None = None
     planner: Planner | None = None
     whole_mission: bool = False
+    options: tuple[str, ...] = ()
+
+    @property
+    def doc(self) -> str:
+        """The first paragraph of its function's docstring, on one line."""
+        run = self.costs if self.costs is not None else self.planner
+        return " ".join((inspect.getdoc(run) or "").split("\n\n")[0].split())
 
     def __call__(self, agents: Sequence[Agent], rooms: Sequence[RoomInfo],
                  weights: Weights) -> NDArray[np.float64]:
@@ -79,9 +88,11 @@ def register_strategy(name: str, matcher: str | None = None) -> Callable[[Costs]
     return add
 
 
-def register_planner(name: str, *, whole_mission: bool = False) -> Callable[[Planner], Planner]:
+def register_planner(name: str, *, whole_mission: bool = False,
+                     options: tuple[str, ...] = ()) -> Callable[[Planner], Planner]:
     def add(planner: Planner) -> Planner:
-        STRATEGIES.register(name)(Strategy(planner=planner, whole_mission=whole_mission))
+        STRATEGIES.register(name)(Strategy(planner=planner, whole_mission=whole_mission,
+                                           options=options))
         return planner
 
     return add
