@@ -15,9 +15,10 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, model_validator
 
-from astralis_des.kinds import KINDS
+from astralis_des.kinds import KIND_DEFAULTS, KINDS
 from astralis_des.mission.spec import PositiveFloat, Strict, Unit
 from astralis_des.streams import stream
+from astralis_des.world.placement import blocking
 
 if TYPE_CHECKING:
     from astralis_des.mission.loader import Mission
@@ -119,7 +120,8 @@ class _OutdoorStarts(Sampler):
         for _ in range(200):
             x, y = gen.uniform([cx - r, cy - r], [cx + r, cy + r])
             p = (float(x), float(y), 0.0)
-            if self.mission.world.contains(p) and _outdoors(self.mission, p):
+            if self.mission.world.contains(p) and _outdoors(self.mission, p) and \
+                    _clear(self.mission, p, kind):
                 return p
         raise RuntimeError(f"no clear outdoor spot within {r} m of {self.centre}")
 
@@ -180,6 +182,13 @@ def _outdoors(mission: Mission, p: Point) -> bool:
         return mission.world.router.place_of(p) == "outdoor"
     except InputError:  # inside an obstacle
         return False
+
+
+def _clear(mission: Mission, p: Point, kind: str) -> bool:
+    """Whether a robot of ``kind`` standing at ``p`` is clear of every solid by its body's
+    radius, as the mission validator wants a start (a draw beside a wall made a failed run)."""
+    which, _ = blocking(mission.world, np.array([p]), KIND_DEFAULTS[kind].radius)
+    return bool(which[0] < 0)
 
 
 Positions = Annotated[FromMission | InBuilding | Outdoor, Field(discriminator="type")]
