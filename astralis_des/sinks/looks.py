@@ -25,6 +25,13 @@ ROBOT_PALETTE: tuple[tuple[int, int, int, int], ...] = (
     (140, 140, 140, 255), (60, 60, 60, 255))
 TABLE_II_COLORS = {"yellow": (240, 200, 40, 255), "red": (215, 40, 40, 255),
                    "purple": (140, 60, 170, 255), "blue": (40, 90, 215, 255)}
+SOLID_COLORS = {"wall": (170, 170, 180, 255), "slab": (120, 120, 130, 60)}
+OBSTACLE_COLOR = (60, 140, 60, 255)  # a tree, a parked vehicle, a lamp post
+ROAD_COLOR = (60, 60, 65, 255)
+FURNITURE_COLORS = {"chair": (139, 90, 43, 255), "cabinet": (110, 110, 90, 255),
+                    "table": (181, 136, 99, 255), "potted_plant": (34, 139, 34, 255),
+                    "computer_desk": (90, 90, 130, 255), "avatar": (250, 200, 60, 255)}
+FURNITURE_COLOR = (150, 150, 150, 255)  # a kind FURNITURE_COLORS does not name
 UAV_ARMS = 6
 UAV_ARM = 0.3  # m, centre to rotor tip (the hexacopter's collision radius)
 HUMAN_HALF = (0.25, 0.2, 0.85)  # m: a walking person's box, half sizes

@@ -13,7 +13,18 @@ from astralis_des.kernel.catalogue import level_of
 from astralis_des.kernel.events import Record
 from astralis_des.sinks import paths
 from astralis_des.sinks.blueprint import blueprint
-from astralis_des.sinks.looks import TABLE_II_COLORS, by_height, by_place, log_body, robot_colors
+from astralis_des.sinks.looks import (
+    FURNITURE_COLOR,
+    FURNITURE_COLORS,
+    OBSTACLE_COLOR,
+    ROAD_COLOR,
+    SOLID_COLORS,
+    TABLE_II_COLORS,
+    by_height,
+    by_place,
+    log_body,
+    robot_colors,
+)
 from astralis_des.sinks.replay import log_lanes, log_metrics, log_rounds, metrics, task_lanes
 from astralis_des.sinks.rrd_check import close_and_check
 from astralis_des.sinks.sensor_log import log_detections, log_pose_sensors, log_sensors
@@ -23,12 +34,6 @@ from astralis_des.world.model import BLOCK, World
 if TYPE_CHECKING:
     from astralis_des.simulation import Simulation
     from astralis_des.simulation.result import RunResult
-
-SOLID_COLORS = {"wall": (170, 170, 180, 255), "slab": (120, 120, 130, 60)}
-OBSTACLE_COLOR = (60, 140, 60, 255)
-FURNITURE_COLORS = {"chair": (139, 90, 43, 255), "cabinet": (110, 110, 90, 255),
-                    "table": (181, 136, 99, 255), "potted_plant": (34, 139, 34, 255),
-                    "computer_desk": (90, 90, 130, 255), "avatar": (250, 200, 60, 255)}
 
 
 class _TextColumn:
@@ -253,7 +258,7 @@ def log_solids(rr: Any, rec: Any, world: World) -> None:
         lo = np.array([s.box.lo for s in world.surfaces])
         hi = np.array([s.box.hi for s in world.surfaces])
         rec.log(paths.WORLD_ROADS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
-                                              colors=[(60, 60, 65, 255)], fill_mode="solid"),
+                                              colors=[ROAD_COLOR], fill_mode="solid"),
                 static=True)
     log_imported(rr, rec, world)
 
@@ -278,7 +283,7 @@ def log_furniture(rr: Any, rec: Any, placed: Sequence[Placed], world: World) -> 
         lo = np.array([p.box.lo for p in mine])
         hi = np.array([p.box.hi for p in mine])
         colors = [TABLE_II_COLORS.get(str(dict(p.attributes).get("color")),  # an avatar's
-                                      FURNITURE_COLORS.get(p.kind, (150, 150, 150, 255)))
+                                      FURNITURE_COLORS.get(p.kind, FURNITURE_COLOR))
                   for p in mine]
         labels = [p.kind if p.kind != "avatar" else
                   "avatar " + " ".join(str(v) for _, v in p.attributes) for p in mine]
