@@ -15,6 +15,8 @@ WORLD_MESH = "world/mesh"  # an imported mesh
 WORLD_CLOUD = "world/cloud"  # an imported cloud, downsampled
 MISSION_EVENTS = "mission/events"
 MISSION_ROUNDS = "mission/assignment"
+MISSION_MATRIX = f"{MISSION_ROUNDS}/matrix"  # each round's Eq. 1 costs, the chosen pairs marked
+MISSION_GRAPH = f"{MISSION_ROUNDS}/graph"  # each round's bipartite graph (a small team's)
 
 
 def world_part(place: str, what: str) -> str:
@@ -55,6 +57,11 @@ def mover(mover_id: str) -> str:
 
 def robot_camera(robot_id: str) -> str:
     return f"robots/{robot_id}/camera"
+
+
+def robot_camera_preview(robot_id: str) -> str:
+    """The camera's first kept frame, dimmed, shown from the start until it is taken."""
+    return f"robots/{robot_id}/camera/preview"
 
 
 def robot_lidar(robot_id: str) -> str:

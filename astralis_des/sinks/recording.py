@@ -12,7 +12,7 @@ import numpy as np
 from astralis_des.kernel.catalogue import level_of
 from astralis_des.kernel.events import Record
 from astralis_des.sinks import paths
-from astralis_des.sinks.blueprint import blueprint
+from astralis_des.sinks.blueprint import Layout, blueprint
 from astralis_des.sinks.looks import (
     FURNITURE_COLOR,
     FURNITURE_COLORS,
@@ -25,7 +25,8 @@ from astralis_des.sinks.looks import (
     log_body,
     robot_colors,
 )
-from astralis_des.sinks.replay import log_lanes, log_metrics, log_rounds, metrics, task_lanes
+from astralis_des.sinks.replay import log_lanes, log_metrics, metrics, task_lanes
+from astralis_des.sinks.rounds import GRAPH_AGENTS, Grid, log_rounds
 from astralis_des.sinks.rrd_check import close_and_check
 from astralis_des.sinks.sensor_log import log_detections, log_pose_sensors, log_sensors
 from astralis_des.world.clutter import Placed
@@ -119,12 +120,15 @@ class RerunRecorder:
         return self._texts.setdefault(entity, _TextColumn())
 
     def on_event(self, record: Record) -> None:
+        """Every event into the event log, at its catalogue's level (also a robot's task
+        text, for the task starts and ends)."""
         t, kind, robot = record["t"], record["kind"], record.get("robot")
-        self._text(paths.MISSION_EVENTS).add(t, describe(record), level_of(record))
+        level = level_of(record)
+        self._text(paths.MISSION_EVENTS).add(t, describe(record), level)
         if robot and kind in ("task_started", "task_finished"):
             state = record["action"] if kind == "task_started" else f"idle ({record['status']})"
             self._text(paths.robot_task(robot)).add(t, f"{state} {record.get('room') or ''}",
-                                                    "INFO")
+                                                    level)
         if kind == "room_change":
             self.rec.set_time(paths.TIMELINE, duration=t)
             self._log_rooms()
@@ -189,12 +193,13 @@ class RerunRecorder:
                 self._sent[entity] = len(robot.trail_t)
 
     def _log_replay(self, result: RunResult, perception: Any) -> None:
-        """Task lanes, assignment graphs, metrics, and the layout that shows them."""
+        """Task lanes, assignment rounds, metrics, and the layout that shows them."""
         rr, rec, sim = self.rr, self.rec, self.sim
         kinds = {rid: robot.kind for rid, robot in sim.robots.items()}
         records = sim.log.records
         log_lanes(rr, rec, task_lanes(records, list(sim.robots)))
-        log_rounds(rr, rec, sim.rounds, kinds)
+        graph = len(kinds) <= GRAPH_AGENTS
+        log_rounds(rr, rec, sim.rounds, kinds, graph)
         cfg = sim.mission.spec.assignment
         log_metrics(rr, rec, metrics(records, sim.rounds, kinds, cfg.high_risk,
                                      cfg.high_messiness), robot_colors(list(sim.robots)))
@@ -207,8 +212,11 @@ class RerunRecorder:
                   max(b.hi[2] for b in rooms)))
         shown = [sim.world.rooms[result.target["room"]]] if result.found_by else \
             [min(searched, key=lambda r: r.floor)]  # up to where it was found, or began
-        rec.send_blueprint(blueprint(result.found_by, cameras, focus, above(sim.world, shown),
-                                     sorted({rid for rid, _ in sim.pose_sensors.sensors})))
+        rec.send_blueprint(blueprint(Layout(
+            team=kinds, focus=focus, end=result.end_time, finder=result.found_by,
+            cameras=cameras, hidden=above(sim.world, shown),
+            sensed=sorted({rid for rid, _ in sim.pose_sensors.sensors}), graph=graph,
+            matrix=Grid.largest(sim.rounds).bounds())))
 
 
 def above(world: World, shown: Sequence[Any]) -> list[str]:

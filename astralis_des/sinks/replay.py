@@ -1,14 +1,12 @@
-"""What a replay explains beyond poses: each robot's task lane, each assignment round's
-bipartite graph, and the mission's metrics as time series. All is derived from the event log
-and the rounds when the run closes, and sent in columns."""
+"""What a replay explains beyond poses: each robot's task lane and the mission's metrics as
+time series (the assignment rounds are in :mod:`astralis_des.sinks.rounds`). All is derived
+from the event log and the rounds when the run closes, and sent in columns."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
-
-import numpy as np
 
 from astralis_des.kernel.events import Record
 from astralis_des.kinds import KIND_DEFAULTS
@@ -63,50 +61,6 @@ def log_lanes(rr: Any, rec: Any, lanes: Mapping[str, Lane]) -> None:
             colors=[LANE_COLORS.get(v, SEARCH_COLOR) for v in values]), static=True)
         rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE, duration=lane.times)],
                          columns=rr.StateChange.columns(state=lane.states))
-
-
-def log_rounds(rr: Any, rec: Any, rounds: Sequence[Mapping[str, Any]],
-               kinds: Mapping[str, str]) -> None:
-    """Each round's bipartite graph at its time: agents on the left, rooms on the right, and
-    between them one small node per edge labelled with Eq. 1's cost; the chosen pairs' cost
-    nodes are large and green, the others small and grey."""
-    for record in rounds:
-        agents, rooms = list(record["agents"]), list(record["rooms"])
-        ids, positions, labels, colors, radii = [], [], [], [], []
-        edges: list[tuple[str, str]] = []
-        for i, agent in enumerate(agents):
-            ids.append(agent)
-            positions.append((0.0, 100.0 * i))
-            labels.append(f"{agent} ({kinds.get(agent, '?')})")
-            colors.append(_color(kinds.get(agent)))
-            radii.append(12.0)
-        for j, room in enumerate(rooms):
-            ids.append(room)
-            positions.append((600.0, 100.0 * j + 50.0 * (len(agents) - len(rooms))))
-            labels.append(f"{room} risk {record['risk'][j]:.2f} mess "
-                          f"{record['messiness'][j]:.2f}")
-            colors.append((int(255 * record["risk"][j]), 60, int(255 * record["messiness"][j])))
-            radii.append(12.0)
-        chosen = {(m["agent"], m["room"]) for m in record["matching"]}
-        for i, agent in enumerate(agents):
-            for j, room in enumerate(rooms):
-                cost = record["costs"][i][j]
-                if cost is None:
-                    continue
-                node = f"{agent}->{room}"
-                share = 0.3 + 0.4 * (j + 1) / (len(rooms) + 1)
-                a, b = np.array(positions[i]), np.array(positions[len(agents) + j])
-                ids.append(node)
-                positions.append(tuple(a + share * (b - a)))
-                picked = (agent, room) in chosen
-                labels.append(f"{cost:.2f}" + (" chosen" if picked else ""))
-                colors.append((40, 220, 90) if picked else (110, 110, 110))
-                radii.append(8.0 if picked else 3.0)
-                edges += [(agent, node), (node, room)]
-        rec.set_time(paths.TIMELINE, duration=record["t"])
-        rec.log(paths.MISSION_ROUNDS, rr.GraphNodes(ids, positions=positions, labels=labels,
-                                                    colors=colors, radii=radii),
-                rr.GraphEdges(edges, graph_type="directed"))
 
 
 Series = dict[str, tuple[list[float], list[float]]]
@@ -175,9 +129,3 @@ def _hazard(kind: str | None) -> str | None:
     """What makes a room unsafe for ``kind`` (None for a kind the run did not name)."""
     record = KIND_DEFAULTS.get(kind or "")
     return record.hazard if record is not None else None
-
-
-def _color(kind: str | None) -> tuple[int, int, int]:
-    """The colour of ``kind``'s node in the round graph (grey for a kind the run did not name)."""
-    record = KIND_DEFAULTS.get(kind or "")
-    return record.color if record is not None else (200, 200, 200)

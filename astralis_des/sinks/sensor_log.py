@@ -21,6 +21,7 @@ if TYPE_CHECKING:
     from astralis_des.navsensors import PoseSensors
 
 Kept = TypeVar("Kept", "KeptFrame", "KeptScan", "KeptCloud")
+PREVIEW_DIM = 0.45  # a camera's first frame, shown before it is taken, at this brightness
 
 
 def _by_robot(items: Sequence[Kept]) -> dict[str, list[Kept]]:
@@ -34,6 +35,7 @@ def _by_robot(items: Sequence[Kept]) -> dict[str, list[Kept]]:
 def log_sensors(rr: Any, rec: Any, perception: Perceived) -> None:
     for rid, frames in _by_robot(perception.frames).items():
         _log_frames(rr, rec, paths.robot_camera(rid), frames)
+        _log_preview(rr, rec, paths.robot_camera_preview(rid), frames[0])
     for rid, kept in _by_robot(perception.scans).items():
         points = np.vstack([s.points for s in kept])
         rec.send_columns(paths.robot_lidar(rid),
@@ -80,6 +82,22 @@ def _log_frames(rr: Any, rec: Any, entity: str, frames: list[KeptFrame]) -> None
         rec.log(f"{entity}/rgb", rr.Image(frame.rgb).compress(jpeg_quality=85))
         rec.log(f"{entity}/depth", rr.DepthImage(frame.depth, meter=1000.0))
         rec.log(f"{entity}/segmentation", rr.SegmentationImage(frame.segmentation))
+
+
+def _log_preview(rr: Any, rec: Any, entity: str, first: KeptFrame) -> None:
+    """A camera keeps frames only once its robot searches, so from the start of the timeline
+    (where the viewer opens) to its first frame its panel would be black: its first frame,
+    dimmed and captioned with when it is taken, stands in until then."""
+    if first.time <= 0.0:
+        return
+    height, width = first.rgb.shape[:2]
+    rec.set_time(paths.TIMELINE, duration=0.0)
+    rec.log(entity, rr.Image((first.rgb * PREVIEW_DIM).astype(np.uint8)).compress(
+        jpeg_quality=85), rr.Points2D([(width / 2, height / 2)], radii=0.0,
+                                       colors=[(255, 255, 255)], show_labels=True,
+                                       labels=[f"first frame at {first.time:.1f} s"]))
+    rec.set_time(paths.TIMELINE, duration=first.time)
+    rec.log(entity, rr.Clear(recursive=False))
 
 
 def log_detections(rr: Any, rec: Any, records: list[Record]) -> None:
