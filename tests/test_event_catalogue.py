@@ -63,7 +63,9 @@ def test_a_failed_task_is_a_warning_and_the_start_is_information() -> None:
     in the replay, and the mission's start too."""
     finished = {"kind": "task_finished", "status": "failed"}
     assert level_of(finished) == "WARN"
-    assert level_of({**finished, "status": "succeeded"}) == "DEBUG"
+    assert level_of({**finished, "status": "succeeded"}) == "INFO"
+    assert level_of({"kind": "task_started"}) == "INFO"  # the mission's story, not noise
+    assert level_of({"kind": "task_queued"}) == "DEBUG"
     assert level_of({"kind": "mission_start"}) == "INFO"
     assert level_of({"kind": "detection"}) == "CRITICAL"
 

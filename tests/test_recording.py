@@ -365,7 +365,7 @@ def test_the_event_log_shows_each_event_at_its_catalogue_level(
     levels = {(e["kind"], r["TextLog:level"][0]) for e, r in zip(result.events, rows,
                                                                   strict=True)}
     assert {("mission_start", "INFO"), ("assignment", "INFO"), ("task_queued", "DEBUG"),
-            ("detection", "CRITICAL")} <= levels
+            ("task_started", "INFO"), ("detection", "CRITICAL")} <= levels
     if run == "faults_run":
         assert {("fault", "ERROR"), ("task_finished", "WARN")} <= levels
     robot = next(iter(result.robots))

@@ -89,11 +89,11 @@ for _kind in (
     EventKind("task_queued", "a task joins a robot's FIFO queue (from an assignment, the "
               "timeline, the API or the chat)", (*TASK, "origin"), robot="always"),
     EventKind("task_started", "a robot starts the task at the head of its queue", TASK,
-              robot="always"),
+              robot="always", level="INFO"),
     EventKind("task_finished", "a task ends: succeeded, failed or cancelled, with the "
               "distance travelled (and a search's coverage)",
               (*TASK, "status", "message", "distance"), ("coverage",), robot="always",
-              raised=(("status", "failed", "WARN"),)),
+              level="INFO", raised=(("status", "failed", "WARN"),)),
     EventKind("took_off", "a UAV leaves the ground to its flight height", ("height",),
               robot="always"),
     EventKind("landed", "a UAV is down where it landed", ("position",), robot="always"),
