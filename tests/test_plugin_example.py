@@ -11,8 +11,7 @@ import sys
 from pathlib import Path
 
 import pytest
-
-from tests.terminal import cli
+from terminal import cli
 
 ROOT = Path(__file__).resolve().parents[1]
 MISSION = ROOT / "examples" / "plugins" / "legged_search.yaml"
