@@ -122,8 +122,7 @@ KIND_DEFAULTS: dict[str, KindDefaults] = {
                           band=(-1.6, 0.15), hazard="risk", person=True,
                           carries=("camera",), look="person", color=(220, 20, 60)),
 }
-BUILT_IN = tuple(KIND_DEFAULTS)  # the paper's three
-NAME = re.compile(r"^[a-z][a-z0-9_]*$")
+NAME = re.compile(r"^[a-z][a-z0-9_]*$")  # a kind's name, as a mission writes it
 
 
 class _Kinds(Sequence[str]):
@@ -177,6 +176,8 @@ def known_kind(kind: str) -> str:
         raise ValueError(f"unknown robot kind {kind!r}; known: {known} (a plug-in adds "
                          "others: plugins: [file.py])")
     return kind
+
+
 TARGET_HEIGHT = 0.5  # m above the floor: the centre of a sitting or laying avatar
 TARGET_SIZE = (0.5, 0.5, 2 * TARGET_HEIGHT)  # m: the box of a sitting avatar
 TARGET_FACE = TARGET_SIZE[1] * TARGET_SIZE[2]  # m^2: its side, seen square on
