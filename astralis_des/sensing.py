@@ -92,8 +92,9 @@ class GeometricSensor:
         furnishes it (in kinematic fidelity, the team's first look at it): the rooms the
         lines start or end in are furnished first, then the scene is asked."""
         scene = self.scene
-        scene.furnish(scene.rooms_at(np.concatenate([np.atleast_2d(p0), np.atleast_2d(p1)])))
-        return scene.line_of_sight(p0, p1)
+        rooms = scene.rooms_at(np.concatenate([np.atleast_2d(p0), np.atleast_2d(p1)]))
+        scene.furnish(rooms)
+        return scene.line_of_sight(p0, p1, rooms)
 
     def _sighting(self, noise_share: float, eye: FloatArray, target: FloatArray, t: float,
                   pixels: int) -> Sighting:

@@ -15,6 +15,7 @@ from astralis_des.kernel.robot import Robot
 from astralis_des.kinds import KIND_DEFAULTS, KindDefaults
 from astralis_des.registry import Registry
 from astralis_des.sinks import paths
+from astralis_des.world.clutter import Placed
 from astralis_des.world.geometry import Box
 from astralis_des.world.model import World
 
@@ -32,6 +33,17 @@ FURNITURE_COLORS = {"chair": (139, 90, 43, 255), "cabinet": (110, 110, 90, 255),
                     "table": (181, 136, 99, 255), "potted_plant": (34, 139, 34, 255),
                     "computer_desk": (90, 90, 130, 255), "avatar": (250, 200, 60, 255)}
 FURNITURE_COLOR = (150, 150, 150, 255)  # a kind FURNITURE_COLORS does not name
+
+
+def solid_color(kind: str) -> tuple[int, int, int, int]:
+    """A solid's colour by its kind: a wall's, a slab's, else an outdoor obstacle's."""
+    return SOLID_COLORS.get(kind, OBSTACLE_COLOR)
+
+
+def placed_color(placed: Placed) -> tuple[int, int, int, int]:
+    """A piece of furniture's colour by its kind; an avatar's, its Table II colour."""
+    return TABLE_II_COLORS.get(str(dict(placed.attributes).get("color")),
+                               FURNITURE_COLORS.get(placed.kind, FURNITURE_COLOR))
 UAV_ARMS = 6
 UAV_ARM = 0.3  # m, centre to rotor tip (the hexacopter's collision radius)
 HUMAN_HALF = (0.25, 0.2, 0.85)  # m: a walking person's box, half sizes

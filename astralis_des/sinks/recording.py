@@ -14,16 +14,13 @@ from astralis_des.kernel.events import Record
 from astralis_des.sinks import paths
 from astralis_des.sinks.blueprint import Layout, blueprint
 from astralis_des.sinks.looks import (
-    FURNITURE_COLOR,
-    FURNITURE_COLORS,
-    OBSTACLE_COLOR,
     ROAD_COLOR,
-    SOLID_COLORS,
-    TABLE_II_COLORS,
     by_height,
     by_place,
     log_body,
+    placed_color,
     robot_colors,
+    solid_color,
 )
 from astralis_des.sinks.replay import log_lanes, log_metrics, metrics, task_lanes
 from astralis_des.sinks.rounds import GRAPH_AGENTS, Grid, log_rounds
@@ -258,7 +255,7 @@ def log_solids(rr: Any, rec: Any, world: World) -> None:
         mine = [solids[i] for i in idx]
         lo = np.array([s.box.lo for s in mine]).reshape(-1, 3)
         hi = np.array([s.box.hi for s in mine]).reshape(-1, 3)
-        colors = [SOLID_COLORS.get(s.kind, OBSTACLE_COLOR) for s in mine]
+        colors = [solid_color(s.kind) for s in mine]
         rec.log(paths.world_part(place, "solids"), rr.Boxes3D(
             centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2, colors=colors, fill_mode="solid"),
             static=True)
@@ -290,9 +287,7 @@ def log_furniture(rr: Any, rec: Any, placed: Sequence[Placed], world: World) -> 
         mine = [placed[i] for i in idx]
         lo = np.array([p.box.lo for p in mine])
         hi = np.array([p.box.hi for p in mine])
-        colors = [TABLE_II_COLORS.get(str(dict(p.attributes).get("color")),  # an avatar's
-                                      FURNITURE_COLORS.get(p.kind, FURNITURE_COLOR))
-                  for p in mine]
+        colors = [placed_color(p) for p in mine]
         labels = [p.kind if p.kind != "avatar" else
                   "avatar " + " ".join(str(v) for _, v in p.attributes) for p in mine]
         rec.log(paths.world_part(place, "furniture"), rr.Boxes3D(

@@ -29,15 +29,7 @@ import numpy as np
 
 from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.sinks import ros_messages as ros
-from astralis_des.sinks.looks import (
-    FURNITURE_COLOR,
-    FURNITURE_COLORS,
-    OBSTACLE_COLOR,
-    ROAD_COLOR,
-    SOLID_COLORS,
-    TABLE_II_COLORS,
-    robot_colors,
-)
+from astralis_des.sinks.looks import ROAD_COLOR, placed_color, robot_colors, solid_color
 from astralis_des.world.geometry import Box
 from astralis_des.world.model import BLOCK, World
 
@@ -48,7 +40,7 @@ if TYPE_CHECKING:
 SPACING = 0.2  # m between the world cloud's points on a face (the planner's voxel)
 POINTS = 500_000  # about the most points the world's faces take (8 MB)
 BODY_SPACING = 0.1  # m between a body's points
-KIND_COLORS = {**SOLID_COLORS, BLOCK: (150, 160, 170, 255)}  # else OBSTACLE_COLOR
+BLOCK_COLOR = (150, 160, 170, 255)  # an imported world's blocks (others: looks.solid_color)
 SCAN_COLOR = (200, 200, 200)  # an imported scan's points that come without colours
 FIELDS = ("x", "y", "z", "rgb")  # each declared FLOAT32 (rgb: the packed colour's bytes)
 ROWS = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("rgb", "<u4")])
@@ -112,14 +104,13 @@ def world_parts(world: World, furniture: Sequence[Placed]) -> tuple[list[Box], l
     for solid in world.solids:
         if solid.kind != BLOCK or not scanned:
             boxes.append(solid.box)
-            colours.append(KIND_COLORS.get(solid.kind, OBSTACLE_COLOR))
+            colours.append(BLOCK_COLOR if solid.kind == BLOCK else solid_color(solid.kind))
     for surface in world.surfaces:
         boxes.append(surface.box)
         colours.append(ROAD_COLOR)
     for placed in furniture:
         boxes.append(placed.box)
-        colours.append(TABLE_II_COLORS.get(str(dict(placed.attributes).get("color")),
-                                           FURNITURE_COLORS.get(placed.kind, FURNITURE_COLOR)))
+        colours.append(placed_color(placed))
     return boxes, colours
 
 

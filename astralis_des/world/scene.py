@@ -278,13 +278,15 @@ class Scene:
         return np.concatenate([self.world.solid_array, extra]) if len(extra) else \
             self.world.solid_array
 
-    def line_of_sight(self, p0: FloatArray, p1: FloatArray) -> np.ndarray:
+    def line_of_sight(self, p0: FloatArray, p1: FloatArray,
+                      rooms: list[str] | None = None) -> np.ndarray:
         """True where nothing lies between ``p0[m]`` and ``p1[m]``. Only the furniture of the
         rooms the segments start or end in can matter: to reach into any other room a
-        segment passes through a wall, which blocks it already. Those rooms must be
-        furnished (:meth:`rooms_at` names them)."""
+        segment passes through a wall, which blocks it already. Those rooms (``rooms``, where
+        the caller has them already: :meth:`rooms_at` of the ends) must be furnished."""
         p0, p1 = np.atleast_2d(p0), np.atleast_2d(p1)
-        rooms = self.rooms_at(np.concatenate([p0, p1]))
+        if rooms is None:
+            rooms = self.rooms_at(np.concatenate([p0, p1]))
         return ~segments_hit_boxes(p0, p1, self.blockers(rooms))
 
     def rooms_at(self, points: FloatArray) -> list[str]:
