@@ -1,9 +1,12 @@
-"""A program on a pseudo-terminal, for the tests of ``astralis chat`` and ``astralis teleop``:
-type into it, wait for text on its screen (with a deadline, so a failure cannot hang)."""
+"""The CLI for tests: in this process (:func:`run_cli`), or as a program on a pseudo-terminal,
+for the tests of ``astralis chat`` and ``astralis teleop``: type into it, wait for text on its
+screen (with a deadline, so a failure cannot hang)."""
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
+import io
 import os
 import pty
 import re
@@ -21,6 +24,17 @@ ANSI = re.compile(rb"\x1b(\[[0-?]*[ -/]*[@-~]|[@-Z\\-_]|\][^\x07]*\x07)")
 
 def cli(*args: str) -> list[str]:
     return [sys.executable, "-m", "astralis_des.cli", *args]
+
+
+def run_cli(*argv: str) -> tuple[int, str, str]:
+    """``astralis ARGV`` in this process, stdout and stderr captured (usable in
+    module-scoped fixtures): the exit code, the output and the errors."""
+    from astralis_des.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(list(argv))
+    return code, out.getvalue(), err.getvalue()
 
 
 def quiet_env(home: Path) -> dict[str, str]:

@@ -5,8 +5,6 @@ Full mission runs are shared through module-scoped fixtures (each takes about ha
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import os
 import re
@@ -18,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from terminal import run_cli
 
 import astralis_des
 from astralis_des.cli import main
@@ -26,14 +25,6 @@ ROOT = Path(__file__).parents[1]
 MISSION = ROOT / "missions" / "urban_search.yaml"
 WORLD = ROOT / "worlds" / "urban_default.yaml"
 TEAM = ["uav1", "uav2", "ugv1", "op1"]
-
-
-def run_cli(*argv: str) -> tuple[int, str, str]:
-    """``main(argv)`` with stdout and stderr captured (usable in module-scoped fixtures)."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        code = main(list(argv))
-    return code, out.getvalue(), err.getvalue()
 
 
 def read_events(folder: Path) -> list[dict[str, Any]]:

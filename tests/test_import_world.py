@@ -45,7 +45,7 @@ def test_a_world_of_areas_alone_loads_with_segments_by_id(tmp_path: Path) -> Non
 
 
 @pytest.mark.parametrize("body,message", [
-    ("areas: []\n", "a world needs buildings or areas: there is nothing to search"),
+    ("areas: []\n", "a world needs buildings, areas or an interior: there is nothing to search"),
     ("areas:\n  - {id: Z.1.1, box: [[1, 1, 0], [9, 9, 8]]}\n", "areas[0].id: String should "
      "match pattern"),
     ("areas:\n  - {id: Z.1.1.1, box: [[1, 1, 0], [60, 9, 8]]}\n", "areas[0].box: area "

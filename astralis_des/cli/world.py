@@ -114,6 +114,11 @@ def _add_import_parser(world_sub: Any) -> None:
                      "(default: what half the free memory holds, at most 50 million)")
     imp.add_argument("--keep-strays", action="store_true", help="keep points lying far from "
                      "the rest of the cloud (left out by default, and counted)")
+    imp.add_argument("--indoor", action="store_true", help="an indoor scan or model: find its "
+                     "storeys, rooms, doors and stairs, searched like a built-in building's "
+                     "(instead of --areas)")
+    imp.add_argument("--group", default="A", help="--indoor: the building's id, the first part "
+                     "of its rooms' ids (default: A)")
 
 
 @world_command("rooms")
@@ -156,7 +161,8 @@ def _world_import(args: argparse.Namespace) -> int:
         up=args.up, scale=args.scale, collision=args.collision, areas=args.areas,
         area_size=args.area_size, margin=args.margin, cloud_points=args.cloud_points,
         seed=args.seed, name=args.name, format=args.format, partial=args.partial,
-        max_points=args.max_points, keep_strays=args.keep_strays)
+        max_points=args.max_points, keep_strays=args.keep_strays, indoor=args.indoor,
+        group=args.group)
     command_line = " ".join(["astralis world import", *sys.argv[3:]]) if \
         sys.argv[1:3] == ["world", "import"] else None
     console = Console(highlight=False, stderr=True, soft_wrap=True)  # a line is one line
@@ -174,7 +180,8 @@ def _world_import(args: argparse.Namespace) -> int:
         what += f" ({report.dropped:,} with NaN or infinite coordinates dropped)"
     out.print(f"[bold]{report.world}[/]: {what}, site {report.site[0]:g} x "
               f"{report.site[1]:g} m, voxel {report.voxel:g} m, {report.blocks:,} blocks, "
-              f"areas {', '.join(report.areas)} ({report.seconds:.2f} s)")
+              + (f"{report.rooms} rooms, {report.doors} doors" if options.indoor else
+                 f"areas {', '.join(report.areas)}") + f" ({report.seconds:.2f} s)")
     for note in report.notes:
         style = "yellow" if note.startswith("warning:") else "dim"
         out.print(f"[{style}]{note}[/]")

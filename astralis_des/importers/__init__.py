@@ -16,7 +16,7 @@ from pathlib import Path
 
 from astralis_des.errors import InputError
 from astralis_des.importers import las, mesh, pcd, ply, pointcloud  # noqa: F401  (readers)
-from astralis_des.importers.options import ImportOptions, ImportReport
+from astralis_des.importers.options import Built, ImportOptions, ImportReport
 from astralis_des.importers.source import (
     READERS,
     Cloud,
@@ -69,7 +69,7 @@ def import_world(source: str | Path, out: str | Path, options: ImportOptions | N
         built = mesh_world(data, path, opts)
     for note in built.notes:
         log.info("%s: %s", path, note)
-    if not built.areas and opts.areas:  # a cloud's importer says why itself
+    if not built.areas and opts.areas and not opts.indoor:  # a cloud's importer says why
         span = " x ".join(f"{v:,.1f}" for v in built.stats.get("extent", ()))
         raise InputError(f"no free floor of at least 4 m x 4 m for a search area: the mesh "
                          f"spans {span} m, the site {built.site[0]:g} x {built.site[1]:g} m "
@@ -86,9 +86,16 @@ def import_world(source: str | Path, out: str | Path, options: ImportOptions | N
         ground=built.source.get("ground"), ground_share=built.stats.get("ground_share"),
         classified_share=built.stats.get("classified_share"),
         seconds=time.perf_counter() - t0, extra=dict(built.stats), notes=tuple(built.notes),
-        voxel=built.voxel)
+        voxel=built.voxel, **_found_inside(built))
     log.info("imported %s as %s in %.2f s", path, target, report.seconds)
     return report
+
+
+def _found_inside(built: Built) -> dict[str, int]:
+    """How many rooms (searched) and doors an indoor import found."""
+    section = built.interior or {}
+    rooms = [p for p in section.get("places", []) if p["kind"] in ("room", "hall")]
+    return {"rooms": len(rooms), "doors": len(section.get("doors", []))}
 
 
 def _command(path: Path, target: Path, opts: ImportOptions) -> str:

@@ -44,6 +44,7 @@ class Blocks:
     canopy: int
     cloud: NDArray[np.float32]  # (C, 3) the replay's sample, world frame
     colors: NDArray[np.uint8] | None
+    points: NDArray[np.float32] | None = None  # (N, 3) every kept point, world frame (indoor)
 
 
 def build(cloud: Cloud, found: Survey, ground: Ground, origin: FloatArray,
@@ -64,6 +65,7 @@ def build(cloud: Cloud, found: Survey, ground: Ground, origin: FloatArray,
     counts = {"ground": 0, "standing": 0, "canopy": 0}
     top = np.array(shape) - 1
     done = 0
+    every = np.empty((found.kept, 3), dtype=np.float32) if opts.indoor else None
     for lo, hi, m in found.metres.chunks():
         keep = found.keep[lo:hi]
         m = m[keep]
@@ -92,6 +94,8 @@ def build(cloud: Cloud, found: Survey, ground: Ground, origin: FloatArray,
         a, b = np.searchsorted(sample, [done, done + len(m)])
         rows = sample[a:b] - done
         picked_xyz[a:b] = np.column_stack([local[rows], height[rows]])
+        if every is not None:
+            every[done:done + len(m)] = np.column_stack([local, height])
         if picked_rgb is not None and cloud.colors is not None:
             picked_rgb[a:b] = cloud.colors[lo:hi][keep][rows]
         done += len(m)
@@ -101,7 +105,7 @@ def build(cloud: Cloud, found: Survey, ground: Ground, origin: FloatArray,
         boxes = np.concatenate([boxes, boxes_from_indices(crown)])
         blocked = np.concatenate([blocked, crown[crown[:, 2] * voxel < AREA_HEIGHT, :2]])
     return Blocks(boxes, blocked, unpack(seen.result(), 2), seen_cell, counts["ground"],
-                  counts["standing"], counts["canopy"], picked_xyz, picked_rgb)
+                  counts["standing"], counts["canopy"], picked_xyz, picked_rgb, every)
 
 
 def _solids(columns: Columns | None, solid: KeySet, voxel: float,

@@ -37,6 +37,7 @@ from astralis_des.importers.ground import (
     grid_size,
     ground_of,
 )
+from astralis_des.importers.indoor_world import indoor_section, outside_interior
 from astralis_des.importers.options import Built, ImportOptions
 from astralis_des.importers.source import Cloud
 from astralis_des.importers.survey import Survey, survey
@@ -63,7 +64,12 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions, fmt: str) -> Buil
     fill = opts.fill if opts.fill != "auto" else ("columns" if fmt in ("las", "laz") else
                                                   "none")
     built = build(cloud, found, ground, origin, shape, voxel, fill, opts, rng)
-    areas = cloud_areas(built, shape, voxel, found, opts, path, notes)
+    interior = None
+    if opts.indoor and built.points is not None:
+        interior = indoor_section(built.points, opts.group, path, notes)
+        built.points = None
+        built.boxes = outside_interior(built.boxes, voxel, interior)
+    areas = [] if opts.indoor else cloud_areas(built, shape, voxel, found, opts, path, notes)
     frame = found.metres.frame
     file_xy = frame.file_xy(origin if frame.projection is None else origin / opts.scale)
     offset = (file_xy[0], file_xy[1], float(np.median(ground.heights) / frame.vertical))
@@ -86,7 +92,7 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions, fmt: str) -> Buil
              "kept": found.kept, "strays": found.strays}
     return Built("cloud", (shape[0] * voxel, shape[1] * voxel), voxel, built.boxes, areas,
                  source, "boxes", floors=[0.0], cloud=built.cloud, cloud_colors=built.colors,
-                 stats=stats, notes=notes)
+                 stats=stats, notes=notes, interior=interior)
 
 
 def _voxel(found: Survey, opts: ImportOptions, path: Path, notes: list[str]) -> float:

@@ -4,6 +4,7 @@ written (:class:`Built`), and what it reports (:class:`ImportReport`)."""
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -42,6 +43,8 @@ class ImportOptions:
     partial: bool = False  # import what a truncated file holds
     max_points: int | None = None  # keep at most this many points (evenly); None: by memory
     keep_strays: bool = False  # keep points far from the rest of the cloud
+    indoor: bool = False  # find storeys, rooms and doors (an indoor scan or model)
+    group: str = "A"  # the id of the building an indoor import finds
 
     def check(self) -> None:
         """Refuse nonsense at the edge, naming the option."""
@@ -67,6 +70,8 @@ class ImportOptions:
              f"must be 0 or more, got {self.margin:g}")
         need(self.areas >= 0, "--areas", f"must be 0 or more, got {self.areas}")
         need(self.cloud_points >= 0, "--cloud-points", "must be 0 or more")
+        need(re.fullmatch(r"[A-Za-z][A-Za-z0-9]*", self.group) is not None, "--group",
+             f"'{self.group}' is no building id: a letter, then letters or digits")
 
 
 @dataclass
@@ -89,6 +94,7 @@ class Built:
     cloud_colors: NDArray[np.uint8] | None = None
     stats: dict[str, Any] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)  # what was chosen, guessed or left out
+    interior: dict[str, Any] | None = None  # the world file's interior: section (indoor)
 
 
 @dataclass(frozen=True)
@@ -113,3 +119,5 @@ class ImportReport:
     extra: dict[str, Any] = field(default_factory=dict)
     notes: tuple[str, ...] = ()  # what was chosen, guessed or left out, a line each
     voxel: float = 0.0
+    rooms: int = 0  # rooms found indoors (searched)
+    doors: int = 0

@@ -28,7 +28,8 @@ def write_world(built: Built, source: Path, out: Path, name: str, command: str) 
     with Staging(out, file=True) as folder:
         geometry = _sidecars(built, folder, stem)
         doc = _document(built, source, out, name, geometry)
-        text = _header(built, source, command) + _dump(doc) + areas_text(built)
+        text = _header(built, source, command) + _dump(doc) + areas_text(built) + \
+            interior_text(built)
         (folder / out.name).write_text(text, encoding="utf-8")
         _check(folder / out.name)
     return [out.parent / str(file) for file in [
@@ -130,4 +131,22 @@ def areas_text(built: Built) -> str:
         lo = ", ".join(f"{v:g}" for v in a.lo)
         hi = ", ".join(f"{v:g}" for v in a.hi)
         lines.append(f"  - {{id: {a.id}, box: [[{lo}], [{hi}]], entry: {a.entry}}}")
+    return "\n".join(lines) + "\n"
+
+
+def interior_text(built: Built) -> str:
+    """The ``interior:`` section, a place, door or stairs a line (easy to correct by hand)."""
+    if built.interior is None:
+        return ""
+    section = built.interior
+    head = {k: v for k, v in section.items() if k not in ("storeys", "places", "doors",
+                                                          "stairs")}
+    lines = ["interior:  # found in the scan: places GROUP.STOREY.SEGMENT.ROOM (passages: "
+             "segment 0)"]
+    lines += [f"  {k}: {v}" for k, v in head.items()]
+    for key in ("storeys", "places", "doors", "stairs"):
+        items = section.get(key) or []
+        lines.append(f"  {key}:" + ("" if items else " []"))
+        lines += ["    - " + yaml.safe_dump(item, default_flow_style=True, width=10**6,
+                                           sort_keys=False).strip() for item in items]
     return "\n".join(lines) + "\n"

@@ -51,7 +51,8 @@ Generated from the schema (`python tools/world_reference.py`; a test checks that
 date; `astralis schema --world` prints the JSON Schema, for editors). A world is a YAML file:
 the site, buildings laid out from a few numbers (storeys, segments of rooms along a corridor,
 a stairwell with a vehicle lift), search areas (boxes on open ground or in an imported scan),
-obstacles and roads. An imported world also has `source` (what was read) and `geometry` (the
+an interior (the storeys, rooms, corridors, doors and stairs found in an indoor scan or model by
+`astralis world import --indoor`, searched like a building's rooms), obstacles and roads. An imported world also has `source` (what was read) and `geometry` (the
 files beside it): `astralis world import` writes those, not a person (how-to: import your
 site). Room ids read building, storey, segment and room: `A.2.1.3` is building A, storey 2,
 segment 1, room 3; `astralis world rooms WORLD` lists a world's buildings, storeys, segments,

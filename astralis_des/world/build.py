@@ -15,6 +15,8 @@ from astralis_des.errors import InputError
 from astralis_des.kinds import KINDS
 from astralis_des.world.geometry import Box
 from astralis_des.world.imported import Imported, area_rooms, ground_slab, load_geometry
+from astralis_des.world.interior import interior_parts
+from astralis_des.world.interior_walls import interior_solids
 from astralis_des.world.model import Building, Door, Room, Segment, Solid, Space, World
 from astralis_des.world.spec import BuildingSpec, WorldSpec
 from astralis_des.yamlio import LocatedYaml, read_bytes
@@ -32,10 +34,19 @@ class _Parts:
 
 
 def build_world(spec: WorldSpec, blocks: list[Solid] | None = None,
-                imported: Imported | None = None) -> World:
-    """The world of ``spec``: its buildings, areas and obstacles, and an imported world's
-    ``blocks`` (read from beside the file by :func:`load_world`)."""
+                imported: Imported | None = None, doc: LocatedYaml | None = None) -> World:
+    """The world of ``spec``: its buildings, areas, interior and obstacles, and an imported
+    world's ``blocks`` (read from beside the file by :func:`load_world`; ``doc`` locates an
+    error in the interior)."""
     parts = _Parts({}, {}, {}, [])
+    plan = None
+    if spec.interior is not None:
+        rooms, segments, spaces, plan = interior_parts(
+            spec.interior, doc or LocatedYaml({}, {}, Path("<world>")))
+        parts.rooms.update(rooms)
+        parts.segments.update(segments)
+        parts.spaces.update(spaces)
+        parts.solids.extend(interior_solids(spec.interior))
     buildings = {b.id: _add_building(b, parts) for b in spec.buildings}
     for obstacle in spec.obstacles:
         cx, cy = obstacle.center
@@ -46,6 +57,7 @@ def build_world(spec: WorldSpec, blocks: list[Solid] | None = None,
         rooms, segments = area_rooms(spec.areas)
         parts.rooms.update(rooms)
         parts.segments.update(segments)
+    if spec.areas or spec.interior is not None:
         parts.solids.append(ground_slab(spec.site.size))
     parts.solids.extend(blocks or [])
     roads = tuple(Solid("road", _road_box(r.start, r.end, r.width), "road") for r in spec.roads)
@@ -53,7 +65,7 @@ def build_world(spec: WorldSpec, blocks: list[Solid] | None = None,
         name=spec.name, site=spec.site.size, buildings=buildings, segments=parts.segments,
         rooms=parts.rooms, spaces=parts.spaces, solids=tuple(parts.solids),
         stairs_passable_by={b.id: tuple(b.stairs_passable_by) for b in spec.buildings},
-        surfaces=roads, imported=imported,
+        surfaces=roads, imported=imported, interior=plan,
         origin=None if spec.site.origin is None else (
             spec.site.origin.latitude, spec.site.origin.longitude, spec.site.origin.altitude),
     )
@@ -98,7 +110,7 @@ def read_world(path: Path) -> World:
     blocks, imported = None, None
     if spec.geometry is not None:
         blocks, imported = load_geometry(spec.geometry, spec.source, doc)
-    world = build_world(spec, blocks, imported)
+    world = build_world(spec, blocks, imported, doc)
     footprints = [world.buildings[b.id].footprint for b in spec.buildings]
     for i, box in enumerate(footprints):
         if box.lo[0] < 0 or box.lo[1] < 0 or box.hi[0] > spec.site.size[0] or \

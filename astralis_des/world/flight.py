@@ -38,7 +38,7 @@ def flight_height(world: World, catalogue: Catalogue) -> float:
     ``catalogue`` (see the module's docstring)."""
     half = UAV_BODY_HALF_HEIGHT
     low = tallest_below(catalogue) + half
-    lintels = [r.door.height for r in world.rooms.values() if r.building in world.buildings]
+    lintels = [r.door.height for r in world.rooms.values() if r.building in world.indoors]
     if not lintels:
         return round(max(low + OPEN_CLEARANCE, KIND_DEFAULTS["uav"].height), 3)
     high = min(lintels) - half

@@ -93,3 +93,17 @@ def resample(points: FloatArray, step: float) -> tuple[FloatArray, FloatArray]:
     s = np.append(np.arange(0.0, total, step), total) if total > 0 else np.zeros(1)
     out = np.column_stack([np.interp(s, cum, points[:, k]) for k in range(points.shape[1])])
     return out, s
+
+
+def inside_polygon(points: FloatArray, polygon: FloatArray | tuple[tuple[float, float], ...]
+                   ) -> NDArray[np.bool_]:
+    """``(N,)`` mask: is each of ``points`` (``(N, 2)`` or more columns; xy used) inside the
+    closed ``polygon`` (``(M, 2)``)? Even-odd rule, vectorised over points and edges."""
+    p = np.atleast_2d(np.asarray(points, dtype=float))[:, :2]
+    a = np.asarray(polygon, dtype=float)
+    b = np.roll(a, -1, axis=0)
+    x, y = p[:, 0:1], p[:, 1:2]
+    spans = (a[:, 1] > y) != (b[:, 1] > y)  # (N, M): the edge crosses the point's row
+    dy = np.where(b[:, 1] == a[:, 1], 1.0, b[:, 1] - a[:, 1])
+    cross_x = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / dy
+    return np.asarray((np.sum(spans & (x < cross_x), axis=1) % 2) == 1)

@@ -12,8 +12,17 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from astralis_des.memo import kept
-from astralis_des.world.geometry import FloatArray, boxes_array
-from astralis_des.world.parts import BLOCK, Building, Door, Room, Segment, Solid, Space
+from astralis_des.world.geometry import FloatArray, boxes_array, inside_polygon
+from astralis_des.world.parts import (
+    BLOCK,
+    Building,
+    Door,
+    InteriorPlan,
+    Room,
+    Segment,
+    Solid,
+    Space,
+)
 from astralis_des.world.routing import Router
 
 if TYPE_CHECKING:
@@ -37,6 +46,7 @@ class World:
     surfaces: tuple[Solid, ...] = ()  # roads and such: drawn, walked on, never in the way
     imported: Imported | None = None  # a digital twin's mesh, cloud and source
     origin: tuple[float, float, float] | None = None  # (0, 0, 0): latitude, longitude, alt
+    interior: InteriorPlan | None = None  # a building found in a scan or model
 
     def memo(self, name: str, limit: int) -> dict[Any, Any]:
         """A cache kept on the world for answers that depend on it and their key alone: it
@@ -55,9 +65,14 @@ class World:
         return {*self.buildings, *(s.building for s in self.segments.values())}
 
     @cached_property
+    def indoors(self) -> frozenset[str]:
+        """The buildings' ids and the interior's group: the rooms of what has walls."""
+        return frozenset([*self.buildings, *([self.interior.group] if self.interior else [])])
+
+    @cached_property
     def areas(self) -> list[Room]:
         """The search areas (rooms out in the open, not in a building)."""
-        return [r for r in self.rooms.values() if r.building not in self.buildings]
+        return [r for r in self.rooms.values() if r.building not in self.indoors]
 
     @cached_property
     def block_array(self) -> FloatArray:
@@ -78,6 +93,8 @@ class World:
                  if r.building in self.buildings]
         doors += [(b.footprint.hi[0], b.entrance[1], b.footprint.lo[2], 0)
                   for b in self.buildings.values()]
+        if self.interior is not None:
+            doors += [(*o.door.center, o.door.normal_axis) for o in self.interior.openings]
         return np.array(doors, dtype=float).reshape(-1, 4)
 
     def near_doorway(self, points: FloatArray, floor: float, within: float) -> np.ndarray:
@@ -96,9 +113,13 @@ class World:
         return Router(self)
 
     def floor_below(self, point: tuple[float, ...] | FloatArray) -> float:
-        """Height of the floor under ``point``: a storey's level inside a building, an area's
-        floor inside an area (the highest at or below the point), else 0."""
+        """Height of the floor under ``point``: a storey's level inside a building or an
+        interior, an area's floor inside an area (the highest at or below the point), else
+        0."""
         x, y, z = float(point[0]), float(point[1]), float(point[2])
+        inner = self.interior
+        if inner is not None and inner.footprint.contains((x, y, inner.footprint.lo[2])):
+            return max((f for f in inner.storeys if f <= z + 0.1), default=inner.storeys[0])
         for b in self.buildings.values():
             lo, hi = b.footprint.lo, b.footprint.hi
             if lo[0] <= x <= hi[0] and lo[1] <= y <= hi[1]:
@@ -133,8 +154,11 @@ class World:
         p = np.asarray(point, dtype=float)
         boxes = self.room_boxes
         inside = np.all((p >= boxes[:, 0] - 1e-6) & (p <= boxes[:, 1] + 1e-6), axis=1)
-        hit = np.flatnonzero(inside)
-        return self.rooms[self.room_ids[hit[0]]] if len(hit) else None
+        for k in np.flatnonzero(inside):  # a room that is no box: in its outline
+            room = self.rooms[self.room_ids[k]]
+            if not room.outline or inside_polygon(p[None, :2], room.outline)[0]:
+                return room
+        return None
 
     def line_of_sight(self, p0: FloatArray, p1: FloatArray) -> np.ndarray:
         """``(M,)`` mask, true where the segment ``p0[m] -> p1[m]`` meets no solid."""

@@ -29,10 +29,16 @@ class Room:
     box: Box
     door: Door
     corridor: str
+    # a room found in a scan or model (``interior:``) that is no rectangle: its floor's
+    # outline (``box`` is its bounds) and the point of its floor farthest from its walls
+    outline: tuple[tuple[float, float], ...] = ()
+    seat: tuple[float, float] | None = None
 
     @property
     def center(self) -> tuple[float, float, float]:
-        """Centre of the floor of the room."""
+        """Centre of the floor of the room (of a room that is no rectangle: its seat)."""
+        if self.seat is not None:
+            return (self.seat[0], self.seat[1], self.box.lo[2])
         c = self.box.center
         return (c[0], c[1], self.box.lo[2])
 
@@ -91,3 +97,33 @@ class Building:
     floor_height: float
     entrance: tuple[float, float, float]  # just outside the entrance door, at ground level
     lift: Box | None = None  # the vehicle lift's shaft in the stairwell (from the ground up)
+
+
+@dataclass(frozen=True)
+class Opening:
+    """A door of an interior found in a scan or model, between two of its places (rooms,
+    halls, corridors, stairwells); ``None`` is the outside (an entrance)."""
+
+    door: Door
+    places: tuple[str, str | None]
+
+
+@dataclass(frozen=True)
+class Stair:
+    """Stairs between two places of an interior on storeys one above the other."""
+
+    places: tuple[str, str]
+    kinds: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class InteriorPlan:
+    """A building found in a scan or model: its places (searched rooms are in the world's
+    ``rooms``, passages in its ``spaces``), doors, stairs and storeys' floor heights."""
+
+    group: str
+    storeys: tuple[float, ...]  # z of each storey's floor, lowest first
+    openings: tuple[Opening, ...]
+    stairs: tuple[Stair, ...]
+    footprint: Box  # the bounds of its places, from the lowest floor to the top storey's top
+    seats: dict[str, tuple[float, float, float]]  # every place's seat (floor height)

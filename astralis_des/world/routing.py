@@ -22,12 +22,13 @@ from scipy.sparse.csgraph import dijkstra
 from astralis_des.errors import InputError
 from astralis_des.kinds import KIND_DEFAULTS, KINDS, KindDefaults
 from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
-from astralis_des.world.parts import BLOCK, Building, Room, Solid, Space
+from astralis_des.world.parts import BLOCK, Building, InteriorPlan, Room, Solid, Space
 
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
 STAIR_RUN_FACTOR = 2.0  # horizontal run of a flight of stairs per metre of rise
 UAV_WELL = 1.5  # m from the stairwell's far wall: where UAVs rise and sink between floors
 DOORWAY = 0.6  # m: routes cross a door square to its wall, from this far inside the room
+WALL_HALF = 0.15  # m: half a found wall (a door's centre is in its middle)
 SNAP = 0.5  # m: a point this close to a room or corridor (in a wall, by a door) belongs to it
 # Not outdoor blockers: walls and slabs are inside footprints, and an imported world's blocks
 # (thousands) are left to the navigator, which flies or walks round them on a grid.
@@ -53,6 +54,8 @@ class Site(Protocol):
     def areas(self) -> list[Room]: ...
     @property
     def stairs_passable_by(self) -> dict[str, tuple[str, ...]]: ...
+    @property
+    def interior(self) -> InteriorPlan | None: ...
     def contains(self, point: tuple[float, ...] | FloatArray) -> bool: ...
     def room_at(self, point: tuple[float, ...] | FloatArray) -> Room | None: ...
 
@@ -68,6 +71,7 @@ class Router:
         self._edges: list[tuple[int, int, dict[str, float]]] = []
         self.corridor_nodes: dict[str, list[int]] = {}
         self.outdoor_nodes: list[int] = []
+        self.place_nodes: dict[str, list[int]] = {}  # an interior's places: their nodes
         self._reach: dict[tuple[str, str, str], bool] = {}
         self._space_ids = list(world.spaces)
         self._space_boxes = boxes_array([s.box for s in world.spaces.values()])
@@ -184,13 +188,15 @@ class Router:
             outside = self._node(f"{b.id}:entrance", b.entrance)
             self._edge(outside, self.corridor_nodes[f"{b.id}.1.corridor"][-1])
             self.outdoor_nodes.append(outside)
+        self._interior()
         for area in w.areas:  # a room in the open: its door is an outdoor place
             door = self._node(f"{area.id}:door", area.door.center)
             inside = self._node(f"{area.id}:inside", area.door_point("room", DOORWAY))
             self._edge(self._node(area.id, area.center), inside)
             self._edge(inside, door)
             self.outdoor_nodes.append(door)
-        for solid in [b.footprint for b in w.buildings.values()] + [
+        inner = [w.interior.footprint] if w.interior is not None else []
+        for solid in [b.footprint for b in w.buildings.values()] + inner + [
             s.box for s in w.solids if s.kind not in NOT_BLOCKERS
         ]:
             for cx in (solid.lo[0] - OUTDOOR_MARGIN, solid.hi[0] + OUTDOOR_MARGIN):
@@ -204,6 +210,44 @@ class Router:
             clear = self._outdoor_clear(np.repeat(pts[a:a + 1], len(others), 0), pts[others])
             for b_idx in others[clear]:
                 self._edge(self.outdoor_nodes[a], self.outdoor_nodes[b_idx])
+
+    def _interior(self) -> None:
+        """A found building's graph: each place's seat and the inside of each of its doors,
+        joined to one another (the navigator walks round what is between them), each door's
+        two sides through it, an entrance's outside to the outdoor places, and stairs from
+        seat to seat, as long as their flights."""
+        plan = self.world.interior
+        if plan is None:
+            return
+        sides: dict[str, list[int]] = {p: [] for p in plan.seats}
+        for k, opening in enumerate(plan.openings):
+            door = opening.door
+            centre = self._node(f"{plan.group}:door{k}", door.center)
+            axis, at = door.normal_axis, door.center[door.normal_axis]
+            first = math.copysign(1.0, plan.seats[opening.places[0]][axis] - at)
+            for place in opening.places:  # the outside is across from the room
+                toward = first if place is None or place == opening.places[0] else \
+                    math.copysign(1.0, plan.seats[place][axis] - at)
+                point = list(door.center)
+                point[axis] += (toward if place is not None else -first) * (DOORWAY + WALL_HALF)
+                node = self._node(f"{plan.group}:door{k}:{place or 'outside'}",
+                                  (point[0], point[1], point[2]))
+                self._edge(node, centre)
+                if place is None:
+                    self.outdoor_nodes.append(node)
+                else:
+                    sides[place].append(node)
+        for place, doors in sides.items():
+            seat = self._node(place, plan.seats[place])
+            nodes = [seat, *doors]
+            for u, v in itertools.combinations(nodes, 2):
+                self._edge(u, v)
+            self.place_nodes[place] = nodes
+        for stair in plan.stairs:
+            low, high = (self.index[p] for p in stair.places)
+            rise = abs(self._pos[high][2] - self._pos[low][2])
+            run = math.dist(self._pos[low][:2], self._pos[high][:2])
+            self._edge(low, high, stair.kinds, run + STAIR_RUN_FACTOR * rise)
 
     def _stairs(self, lower: int, upper: int, y_mid: float, walkers: tuple[str, ...]) -> None:
         """Between two floors of a stairwell, from its landing (the stair node, by the
@@ -220,6 +264,8 @@ class Router:
 
     def _outdoor_blockers(self) -> FloatArray:
         boxes = [b.footprint for b in self.world.buildings.values()]
+        if self.world.interior is not None:
+            boxes.append(self.world.interior.footprint)
         boxes += [s.box for s in self.world.solids if s.kind not in NOT_BLOCKERS]
         return np.array([[[*b.lo[:2], -1.0], [*b.hi[:2], 1.0]] for b in boxes]).reshape(-1, 2, 3)
 
@@ -264,6 +310,8 @@ class Router:
         return self._snap_ids[best] if d[best] < SNAP else None
 
     def _entries(self, p: FloatArray, place: str) -> list[int]:
+        if place in self.place_nodes:
+            return self.place_nodes[place]
         if place in self.world.rooms:
             return [self.index[place], self.index[f"{place}:inside"]]
         if place in self.corridor_nodes:

@@ -209,6 +209,91 @@ class GeometrySpec(Strict):
         return self
 
 
+# -- interior: a building found in a scan or model (``astralis world import --indoor``) ------
+# A place is a room, a hall, a corridor or a stairwell, given by its outline on its storey's
+# floor (a polygon, metres, walls left out). Rooms and halls are searched; corridors and
+# stairwells are passages. Ids read GROUP.STOREY.SEGMENT.ROOM like the built-in buildings'
+# rooms: a segment is the rooms off one corridor or hall; passages are segment 0.
+PLACE_ID = r"^[A-Za-z][A-Za-z0-9]*\.[1-9][0-9]*\.[0-9]+\.[1-9][0-9]*$"
+SEARCHED = ("room", "hall")  # the kinds of place a mission searches
+PASSAGES = ("corridor", "stairwell")
+OUTSIDE = "outside"  # a door's far side when it is an entrance
+
+
+class StoreySpec(Strict):
+    level: PositiveInt = Field(description="1 for the lowest; the STOREY of the places' ids")
+    z: Coordinate = Field(description="m, the floor's height")
+    height: Length = Field(description="m, floor to floor (the clear height of the top one)")
+
+
+class PlaceSpec(Strict):
+    id: str = Field(pattern=PLACE_ID, description="GROUP.STOREY.SEGMENT.ROOM; passages "
+                    "(corridors, stairwells) are segment 0")
+    kind: Literal["room", "hall", "corridor", "stairwell"] = Field(
+        "room", description="rooms and halls are searched; corridors and stairwells are not")
+    outline: list[Vec2] = Field(min_length=3, description="[[x, y], ...]: the floor's "
+                                "outline inside the walls, metres")
+
+    @property
+    def storey(self) -> int:
+        return int(self.id.split(".")[1])
+
+    @property
+    def searched(self) -> bool:
+        return self.kind in SEARCHED
+
+    @model_validator(mode="after")
+    def _segment_fits_kind(self) -> PlaceSpec:
+        passage = self.id.split(".")[2] == "0"
+        if passage != (self.kind in PASSAGES):
+            raise ValueError(f"a {self.kind}'s id has segment "
+                             f"{'0' if self.kind in PASSAGES else '1 or more'}: "
+                             f"'{self.id}'")
+        return self
+
+
+class DoorSpec(Strict):
+    at: Vec2 = Field(description="[x, y]: the door's centre, in the middle of its wall")
+    across: Literal["x", "y"] = Field(description="the way one walks through it: 'x' for a "
+                                      "door in a wall along y")
+    width: Length = Field(le=20.0, description="m, the free gap between its jambs")
+    height: Length = Field(2.1, description="m, under its lintel")
+    between: tuple[str, str] = Field(description="the places it joins: two ids, or an id and "
+                                     f"'{OUTSIDE}' (an entrance)")
+
+
+class StairSpec(Strict):
+    between: tuple[str, str] = Field(description="two places on storeys one above the other "
+                                     "(stairwells, or whatever holds the stairs)")
+    passable_by: list[Kind] = Field(default_factory=lambda: list(KINDS),
+                                    description="who can take them (all kinds by default)")
+
+
+class InteriorSpec(Strict):
+    """A building found in a scan or model; its places' ids start with ``group``."""
+
+    group: str = Field(pattern=r"^[A-Za-z][A-Za-z0-9]*$", description="the building's letter(s)"
+                       ": a mission's assignment.search names it")
+    heading: float = Field(0.0, ge=-180, le=180, description="degrees the scan was turned so "
+                           "its walls run along x and y (for the record)")
+    storeys: list[StoreySpec] = Field(min_length=1, description="lowest first")
+    places: list[PlaceSpec] = Field(min_length=1, description="rooms, halls, corridors and "
+                                    "stairwells")
+    doors: list[DoorSpec] = Field(default_factory=list, description="each room needs one")
+    stairs: list[StairSpec] = Field(default_factory=list, description="between storeys")
+
+    @field_validator("storeys")
+    @classmethod
+    def _levels_in_order(cls, storeys: list[StoreySpec]) -> list[StoreySpec]:
+        levels = [s.level for s in storeys]
+        if levels != list(range(1, len(levels) + 1)):
+            raise ValueError(f"levels must be 1, 2, ... in order, got {levels}")
+        heights = [s.z for s in storeys]
+        if heights != sorted(heights) or len(set(heights)) != len(heights):
+            raise ValueError(f"each storey's z must be above the one below, got {heights}")
+        return storeys
+
+
 class WorldSpec(Strict):
     name: str
     site: SiteSpec
@@ -218,6 +303,8 @@ class WorldSpec(Strict):
     roads: list[RoadSpec] = Field(default_factory=list)
     source: SourceSpec | None = None
     geometry: GeometrySpec | None = None
+    interior: InteriorSpec | None = Field(None, description="a building found in an indoor "
+                                          "scan or model (astralis world import --indoor)")
 
     @field_validator("buildings")
     @classmethod
@@ -233,6 +320,7 @@ class WorldSpec(Strict):
 
     @model_validator(mode="after")
     def _something_to_search(self) -> WorldSpec:
-        if not self.buildings and not self.areas:
-            raise ValueError("a world needs buildings or areas: there is nothing to search")
+        if not self.buildings and not self.areas and self.interior is None:
+            raise ValueError("a world needs buildings, areas or an interior: there is nothing "
+                             "to search")
         return self

@@ -1,0 +1,157 @@
+"""An indoor scan becomes a world searched room by room (issue 42): ``astralis world import
+--indoor`` on a scan of the default world's building A writes its storeys, rooms, doors and
+stairs; the twin's rooms are the original's, the paper's team searches it in both fidelities
+with the same first-round Eq. 1 assignment, and a corrected world file is checked line by
+line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+from indoor_scenes import building_a, face_cloud
+from terminal import run_cli
+
+from astralis_des import Simulation, load_mission
+from astralis_des.errors import InputError
+from astralis_des.world.build import load_world, read_world
+
+ROOT = Path(__file__).resolve().parents[1]
+MARGIN = 40  # m of site round the building: room for the team's starts outside it
+
+
+def write_ply(path: Path, points: np.ndarray) -> Path:
+    """A binary little-endian PLY of ``points`` (float32 x, y, z)."""
+    header = ("ply\nformat binary_little_endian 1.0\n"
+              f"element vertex {len(points)}\nproperty float x\nproperty float y\n"
+              "property float z\nend_header\n")
+    path.write_bytes(header.encode("ascii") + points.astype("<f4").tobytes())
+    return path
+
+
+@pytest.fixture(scope="module")
+def twin(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """Building A's scan imported with --indoor: the world file and what the CLI printed."""
+    folder = tmp_path_factory.mktemp("twin")
+    scan = write_ply(folder / "a.ply", face_cloud(building_a(), 0.05))
+    code, out, err = run_cli("world", "import", str(scan), "-o", str(folder / "a.yaml"),
+                             "--indoor", "--margin", str(MARGIN))
+    assert code == 0, err
+    return folder / "a.yaml", out
+
+
+def offset(world_file: Path) -> np.ndarray:
+    """Where the twin's (0, 0) lies in the scan's (the default world's) coordinates."""
+    doc = yaml.safe_load(world_file.read_text(encoding="utf-8"))
+    return np.array(doc["source"]["offset"][:2])
+
+
+def test_the_import_finds_building_a(twin: tuple[Path, str]) -> None:
+    path, out = twin
+    assert "18 rooms, 21 doors" in " ".join(out.split())
+    world, original = load_world(path), load_world(ROOT / "worlds" / "urban_default.yaml")
+    want = sorted(r for r in original.rooms if r.startswith("A."))
+    assert sorted(world.rooms) == want
+    shift = offset(path)
+    for rid in want:  # each room where the original's is, inside its walls
+        mine, theirs = world.rooms[rid].box, original.rooms[rid].box
+        assert np.allclose(np.add(mine.lo[:2], shift), theirs.lo[:2], atol=0.15), rid
+        assert np.allclose(np.add(mine.hi[:2], shift), theirs.hi[:2], atol=0.15), rid
+        assert mine.lo[2] == pytest.approx(theirs.lo[2], abs=0.15)
+        door, true_door = world.rooms[rid].door, original.rooms[rid].door
+        assert np.allclose(np.add(door.center[:2], shift), true_door.center[:2], atol=0.3)
+        assert door.width == pytest.approx(true_door.width, abs=0.2)
+    assert world.segment_order("A") == original.segment_order("A")
+    assert [s.kind for s in world.spaces.values()].count("passage") == 3  # a corridor a storey
+
+
+def mission_in(world_file: Path, tmp: Path, fidelity: str = "kinematic") -> Path:
+    """missions/urban_search.yaml with the twin for its world and its team's starts moved by
+    the import's offset."""
+    doc: dict[str, Any] = yaml.safe_load((ROOT / "missions" / "urban_search.yaml").read_text())
+    doc["world"] = str(world_file)
+    doc["fidelity"] = fidelity
+    shift = offset(world_file)
+    for member in doc["team"]:
+        member["start"] = [round(float(member["start"][0] - shift[0]), 3),
+                           round(float(member["start"][1] - shift[1]), 3), 0]
+    path = tmp / f"twin_{fidelity}.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
+    return path
+
+
+def first_round(result: Any) -> list[tuple[str, str, str]]:
+    return [(m["agent"], m["room"], m["action"]) for m in result.rounds[0]["matching"]]
+
+
+@pytest.mark.parametrize("fidelity", ["kinematic", "physics"])
+def test_the_paper_team_searches_the_twin_as_the_original(
+        twin: tuple[Path, str], tmp_path: Path, fidelity: str) -> None:
+    """Eq. 1's first round is the original world's; the target is found, no task fails."""
+    original = Simulation(load_mission(ROOT / "missions" / "urban_search.yaml")).run()
+    result = Simulation(load_mission(mission_in(twin[0], tmp_path, fidelity))).run()
+    assert result.rounds[0]["rooms"] == original.rounds[0]["rooms"]
+    assert first_round(result) == first_round(original)
+    assert result.found and result.found_by == original.found_by
+    failed = [e for e in result.events if e["kind"] == "task_finished"
+              and e["status"] == "failed"]
+    assert failed == []
+
+
+def test_routes_take_the_stairs_to_the_top_storey(twin: tuple[Path, str]) -> None:
+    """From outside, each kind reaches a room on storey 3 by the entrance and the stairs."""
+    world = load_world(twin[0])
+    outside = world.interior.footprint.hi[0] + 5.0 if world.interior else 0.0
+    start = (outside, world.interior.footprint.center[1] if world.interior else 0.0, 0.0)
+    for kind in ("uav", "ugv", "human"):
+        route = world.router.route(start, world.rooms["A.3.1.2"].center, kind)
+        assert route is not None, kind
+        assert route[-1][2] == pytest.approx(world.interior.storeys[2] if world.interior else 0)
+        assert np.all(np.diff(route[:, 2]) >= -1e-9)  # up, never down
+
+
+def edited(world_file: Path, old: str, new: str, tmp: Path) -> Path:
+    text = world_file.read_text(encoding="utf-8")
+    assert old in text
+    path = tmp / world_file.name
+    for sidecar in world_file.parent.glob(f"{world_file.stem}.*.npz"):
+        (tmp / sidecar.name).write_bytes(sidecar.read_bytes())
+    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+    return path
+
+
+def line_of(path: Path, text: str) -> int:
+    return next(n for n, line in enumerate(path.read_text().splitlines(), 1) if text in line)
+
+
+def test_a_corrected_world_is_checked_line_by_line(twin: tuple[Path, str],
+                                                   tmp_path: Path) -> None:
+    """A door to a place that is not there, and a room left with no door, are one line that
+    names the file, the line and the key."""
+    path = twin[0]
+    bad = edited(path, "between: [A.1.2.1, A.1.0.2]", "between: [A.1.2.1, A.1.0.9]", tmp_path)
+    with pytest.raises(InputError) as err:
+        read_world(bad)
+    assert err.value.line == line_of(bad, "A.1.0.9") and "no place 'A.1.0.9'" in str(err.value)
+    assert "interior.doors[" in str(err.value)
+    lonely = edited(path, "between: [A.1.2.1, A.1.0.2]", "between: [A.1.2.2, A.1.0.2]", tmp_path)
+    with pytest.raises(InputError, match=r"no door leads into 'A.1.2.1'") as err:
+        read_world(lonely)
+    assert err.value.line == line_of(lonely, "id: A.1.2.1,")
+    code, _, err_text = run_cli("validate", str(lonely))
+    assert code == 2 and len(err_text.strip().splitlines()) == 1
+
+
+def test_a_scan_with_no_storey_is_refused_in_one_line(tmp_path: Path) -> None:
+    """A flat field has no storey: no room is made up."""
+    rng = np.random.default_rng(0)
+    ground = np.column_stack([rng.uniform(0, 30, 50_000), rng.uniform(0, 30, 50_000),
+                              rng.normal(0, 0.02, 50_000)])
+    code, _, err = run_cli("world", "import", str(write_ply(tmp_path / "f.ply", ground)),
+                           "-o", str(tmp_path / "f.yaml"), "--indoor")
+    assert code == 2
+    assert "--indoor: no storey found" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "f.yaml").exists()
