@@ -7,7 +7,7 @@ floor heights, each room's inner floor rectangles, each door's centre and width.
 see them: a face inside another box is hidden (a slab under a wall), and so is one out of reach
 of the rooms, corridors and doorways (the outer faces of the outer walls, the roof's top, a
 sealed void). Then a little Gaussian noise and a random share of the points dropped, as
-occlusion would. (Simulating the 3-D lidar's flight is a later step.)
+occlusion would. (The 3-D lidar flown through a scene: ``tests/indoor_scan.py``.)
 
 The scenes: building A of the default world (:func:`building_a`; any world file's building:
 :func:`world_building`) and a generated building of irregular rooms (:func:`irregular`).

@@ -5,6 +5,13 @@ Plans are drawn along the walls: the cloud is turned by minus the walls' heading
 :func:`.heading.wall_heading` unless given) about the origin, and everything found (plans,
 rooms' cells, polygons and boxes, doors' centres and axes) is in that turned frame, the
 plan's; :meth:`Interior.to_cloud` turns plan coordinates back into the cloud's.
+
+A space no door leads into, on a storey where doors join the others, is sealed: no room but a
+**void** (:attr:`Interior.voids`). A scan never sees inside one, but a modelled building's
+mesh shows every face, those of its sealed spaces too (building A of the default world has
+one at each end of its corridor's far side, between its last rooms and its east wall), and
+its floor, walls and ceiling look like a room's. A storey without any door keeps its spaces
+as rooms (one room scanned, its door shut).
 """
 
 from __future__ import annotations
@@ -38,9 +45,10 @@ class Interior:
     heading: float  # radians from the cloud's x axis to the plan's (along the walls)
     storeys: tuple[Storey, ...]
     plans: tuple[Plan, ...]
-    labels: tuple[IntArray, ...]  # per storey: each free cell's room label, 0 elsewhere
+    labels: tuple[IntArray, ...]  # per storey: each free cell's room or void label, else 0
     rooms: tuple[FoundRoom, ...]
     doors: tuple[FoundDoor, ...]
+    voids: tuple[FoundRoom, ...] = ()  # sealed spaces (kind "void", ids ``storey.vK``)
 
     def doors_of(self, room: str) -> list[FoundDoor]:
         return [d for d in self.doors if room in d.rooms]
@@ -85,13 +93,14 @@ def find_interior(points: FloatArray, *, normals: FloatArray | None = None,
     points = turned(points, -heading)
     if normals is not None:
         normals = turned(np.asarray(normals, dtype=float), -heading)
-    plans, grids, rooms, doors = [], [], [], []
+    plans, grids, rooms, doors, voids = [], [], [], [], []
     for storey in storeys:
         plan = storey_plan(points, storey, cell, knee, head, normals)
         labels = segment(plan.free, cell, door_max)
         found = find_doors(plan, labels, {k: str(k) for k in range(1, int(labels.max()) + 1)})
         count = Counter(int(r) for d in found for r in d.rooms if r is not None)
-        storey_rooms = describe(plan, labels, dict(count))
+        storey_rooms, sealed = _sealed_apart(describe(plan, labels, dict(count)), count)
+        voids += sealed
         ids = {str(r.label): r.id for r in storey_rooms}
         doors += [replace(d, rooms=(ids.get(d.rooms[0] or ""), ids.get(d.rooms[1] or "")))
                   for d in found]
@@ -99,4 +108,19 @@ def find_interior(points: FloatArray, *, normals: FloatArray | None = None,
         grids.append(labels)
         rooms += storey_rooms
     return Interior(cell, round(spacing, 4), heading, tuple(storeys), tuple(plans),
-                    tuple(grids), tuple(rooms), tuple(doors))
+                    tuple(grids), tuple(rooms), tuple(doors), tuple(voids))
+
+
+def _sealed_apart(found: list[FoundRoom], doors: Counter[int]
+                  ) -> tuple[list[FoundRoom], list[FoundRoom]]:
+    """A storey's rooms with doors and its voids (see the module's docstring), each numbered
+    anew in :func:`.rooms.describe`'s order: ``storey.k`` and ``storey.vK``."""
+    if not doors:
+        return found, []
+    rooms = [r for r in found if doors[r.label]]
+    voids = [r for r in found if not doors[r.label]]
+    if voids:
+        log.info("storey %d: %d sealed space(s) no door leads into, set apart as voids",
+                 found[0].storey, len(voids))
+    return ([replace(r, id=f"{r.storey}.{k}") for k, r in enumerate(rooms, start=1)],
+            [replace(r, id=f"{r.storey}.v{k}", kind="void") for k, r in enumerate(voids, start=1)])

@@ -45,7 +45,7 @@ class FoundRoom:
     id: str
     storey: int
     label: int  # its number in the storey's label grid
-    kind: str  # room, corridor or hall
+    kind: str  # room, corridor or hall (void: sealed, in ``Interior.voids``)
     area: float  # m²
     lo: tuple[float, float]  # bounding box
     hi: tuple[float, float]
