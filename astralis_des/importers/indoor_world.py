@@ -12,7 +12,6 @@ from typing import Any
 import numpy as np
 
 from astralis_des.errors import InputError
-from astralis_des.importers.cloudbuild import MIN_HEIGHT
 from astralis_des.importers.indoor import find_interior
 from astralis_des.importers.indoor.twin import twin_section
 from astralis_des.world.interior_walls import interior_bounds
@@ -23,9 +22,9 @@ TURN = 1.0  # degrees: walls further off the axes are refused (the world's rooms
 
 
 def indoor_section(points: np.ndarray, group: str, path: Path,
-                   notes: list[str]) -> dict[str, Any]:
-    """The ``interior:`` section of ``points`` (``(N, 3)``, world frame: heights above the
-    ground)."""
+                   notes: list[str]) -> tuple[dict[str, Any], float]:
+    """The ``interior:`` section of ``points`` (``(N, 3)``, world frame), its lowest floor at
+    ``z = 0``, and the height that floor was found at (the world is lowered by it)."""
     try:
         found = find_interior(np.asarray(points, dtype=float))
         turn = math.degrees(found.heading)
@@ -39,7 +38,8 @@ def indoor_section(points: np.ndarray, group: str, path: Path,
     if not found.storeys:
         raise InputError("--indoor: no storey found (no floor under a ceiling with walls "
                          "between): is this an indoor scan?", file=path)
-    twin = twin_section(found, group, [_stand(s.z) for s in found.storeys])
+    lowest = found.storeys[0].z
+    twin = twin_section(found, group, [round(s.z - lowest, 2) for s in found.storeys])
     notes.extend(twin.notes)
     places: list[dict[str, Any]] = twin.section["places"]  # type: ignore[assignment]
     rooms = [p for p in places if p["kind"] in ("room", "hall")]
@@ -50,13 +50,7 @@ def indoor_section(points: np.ndarray, group: str, path: Path,
                  f"{len(places) - len(rooms)} corridors and stairwells, "
                  f"{len(twin.section['doors'])} doors (walls at "  # type: ignore[arg-type]
                  f"{math.degrees(found.heading):.1f} degrees)")
-    return twin.section
-
-
-def _stand(z: float) -> float:
-    """Where a robot stands on a floor found at ``z``: on it (its slab is made under it,
-    :mod:`astralis_des.world.interior_walls`), or on the ground for the lowest."""
-    return 0.0 if z < MIN_HEIGHT else round(z, 2)
+    return twin.section, lowest
 
 
 def outside_interior(boxes: np.ndarray, voxel: float, section: dict[str, Any]) -> np.ndarray:

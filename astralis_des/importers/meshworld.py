@@ -17,6 +17,8 @@ from scipy import ndimage
 
 from astralis_des.errors import InputError
 from astralis_des.importers.areas import Area, Level, place_areas
+from astralis_des.importers.indoor.surface import surface_points
+from astralis_des.importers.indoor_world import indoor_section, outside_interior
 from astralis_des.importers.mesh import (
     choose_up,
     closed_faces,
@@ -39,6 +41,7 @@ AREA_HEIGHT = 10.0  # m: the most an area reaches above its floor
 MIN_AREA_HEIGHT = 2.5
 AREA_LEVELS = 8  # the floors with the most area that search areas may be placed on
 MESH_VOXEL = 0.2  # m, unless --voxel says
+INDOOR_SPACING = 0.04  # m between the points an indoor mesh is sampled with (--indoor)
 VHACD_RESOLUTION = 50_000  # voxels of V-HACD's decomposition (its default, 100,000, is slower)
 
 
@@ -58,6 +61,13 @@ def mesh_world(mesh: Mesh, path: Path, opts: ImportOptions) -> Built:
     used = np.unique(faces)
     origin = turned[used].min(axis=0) - np.array([opts.margin, opts.margin, 0.0])
     vertices = turned - origin
+    notes: list[str] = []
+    interior = None
+    if opts.indoor:  # storeys, rooms and doors, the lowest floor brought to z = 0
+        points = surface_points(vertices, faces, INDOOR_SPACING, seed=opts.seed)
+        interior, floor = indoor_section(points, opts.group, path, notes)
+        origin[2] += floor
+        vertices[:, 2] -= floor
     tri = triangles(vertices, faces)
     extent = vertices[used].max(axis=0) + np.array([opts.margin, opts.margin, 0.0])
     shape = grid_shape(extent + voxel, voxel, what="the mesh")
@@ -72,8 +82,12 @@ def mesh_world(mesh: Mesh, path: Path, opts: ImportOptions) -> Built:
     found = floor_levels(tri)
     levels = sorted({0.0, *(z for z, _ in found)})
     widest = sorted(z for z, _ in sorted(found, key=lambda f: -f[1])[:AREA_LEVELS])
-    areas = _areas(tri, cells, sorted({0.0, *widest}), shape, voxel, opts)
-    collision = opts.collision if opts.collision != "auto" else "concave"
+    if interior is not None:  # its walls and floors are made from it; the rest stays
+        boxes = outside_interior(boxes, voxel, interior)
+    areas = [] if opts.indoor else _areas(tri, cells, sorted({0.0, *widest}), shape, voxel,
+                                          opts)
+    collision = opts.collision if opts.collision != "auto" else \
+        "boxes" if opts.indoor else "concave"
     parts = _convex_parts(vertices, faces) if collision == "convex" else None
     back = _to_source(origin / scale, up)
     source = {"kind": "mesh", "faces": len(mesh.faces), "dropped": dropped,
@@ -85,7 +99,8 @@ def mesh_world(mesh: Mesh, path: Path, opts: ImportOptions) -> Built:
                  floors=levels, vertices=vertices, faces=faces, parts=parts,
                  stats={"watertight": mesh.watertight, "surface_voxels": len(cells),
                         "extent": tuple(float(v) for v in vertices[used].max(axis=0) -
-                                        vertices[used].min(axis=0))})
+                                        vertices[used].min(axis=0))},
+                 notes=notes, interior=interior)
 
 
 def _to_source(origin: FloatArray, up: str) -> tuple[float, float, float]:

@@ -49,16 +49,17 @@ WORLD_INTRO = """# World file reference
 
 Generated from the schema (`python tools/world_reference.py`; a test checks that it is up to
 date; `astralis schema --world` prints the JSON Schema, for editors). A world is a YAML file:
-the site, buildings laid out from a few numbers (storeys, segments of rooms along a corridor,
-a stairwell with a vehicle lift), search areas (boxes on open ground or in an imported scan),
-an interior (the storeys, rooms, corridors, doors and stairs found in an indoor scan or model by
-`astralis world import --indoor`, searched like a building's rooms), obstacles and roads. An imported world also has `source` (what was read) and `geometry` (the
-files beside it): `astralis world import` writes those, not a person (how-to: import your
-site). Room ids read building, storey, segment and room: `A.2.1.3` is building A, storey 2,
-segment 1, room 3; `astralis world rooms WORLD` lists a world's buildings, storeys, segments,
-rooms and doors, the ids a mission names. What a world may hold (finite numbers, rooms a
-robot fits in, at most 10,000 rooms) is in `docs/worlds.md`. Keys are dotted paths as in the
-mission reference; the example column is the value in `{example}`.
+the site, buildings laid out from a few numbers (storeys, segments of rooms along a corridor, a
+stairwell with a vehicle lift), search areas (boxes on open ground or in an imported scan), an
+interior (the storeys, rooms, corridors, doors and stairs found in an indoor scan or model by
+`astralis world import --indoor`, searched like a building's rooms), obstacles and roads. An
+imported world also has `source` (what was read) and `geometry` (the files beside it): `astralis
+world import` writes those, not a person (how-to: import your site). Room ids read building,
+storey, segment and room: `A.2.1.3` is building A, storey 2, segment 1, room 3; `astralis world
+rooms WORLD` lists a world's buildings, storeys, segments, rooms and doors, the ids a mission
+names. What a world may hold (finite numbers, rooms a robot fits in, at most 10,000 rooms) is in
+`docs/worlds.md`. Keys are dotted paths as in the mission reference; the example column is the
+value in `{example}`.
 
 | key | type | default | what | example |
 | --- | --- | --- | --- | --- |

@@ -20,6 +20,7 @@ from astralis_des.world.spec import InteriorSpec
 CELL = 0.05  # m, the grid walls are made on
 WALL = 0.2  # m, the outer walls' thickness (round the places' bounds)
 SLAB = 0.2  # m, a floor's or the roof's thickness
+THROUGH = 0.4  # m either side of a door's middle that its doorway cuts through walls
 BoolArray = NDArray[np.bool_]
 
 
@@ -82,9 +83,10 @@ def _stairwells(spec: InteriorSpec, level: int, centres: np.ndarray,
 
 def _doorway(at: tuple[float, float], across: str, width: float, lo: np.ndarray,
              shape: tuple[int, ...]) -> BoolArray:
-    """The cells of a doorway: ``width`` along its wall, two walls' thickness across it."""
+    """The cells of a doorway: ``width`` along its wall, ``THROUGH`` either side of its
+    middle across it (through a thick wall, and a found door's middle may be off the wall's)."""
     axis = 0 if across == "x" else 1
-    half = np.array([WALL, WALL])
+    half = np.array([THROUGH, THROUGH])
     half[1 - axis] = width / 2
     a = np.floor((np.asarray(at) - half - lo) / CELL + 0.5).astype(int)
     b = np.floor((np.asarray(at) + half - lo) / CELL + 0.5).astype(int)

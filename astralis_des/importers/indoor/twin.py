@@ -1,7 +1,8 @@
 """What :func:`.interior.find_interior` found, as a world file's ``interior:`` section.
 
-- **Stairwells.** A place most of whose floor lies under an opening in the storey above (free
-  of walls inside the building, with no floor) is a stairwell. Each opening of at least
+- **Stairwells.** A room (not a corridor or hall, which may hold a landing) most of whose
+  floor lies under an opening in the storey above (free of walls inside the building, with no
+  floor) is a stairwell. Each opening of at least
   ``MIN_SHAFT`` m² has stairs, from the place under it (or beside it, where the storey below
   has no floor there either) to the place beside it above.
 - **Ids.** ``GROUP.STOREY.SEGMENT.ROOM``. Passages (corridors, stairwells) are segment 0. A
@@ -169,7 +170,7 @@ def _shafts(found: Interior) -> tuple[set[str], list[tuple[str, str]]]:
         opening = high.inside & ~high.floor & ~high.walls
         parts, count = ndimage.label(opening)
         below = _resample(low_labels, low, high, opening.shape)
-        for room in (r for r in found.rooms if r.storey == k + 1):
+        for room in (r for r in found.rooms if r.storey == k + 1 and r.kind == "room"):
             cells = below == room.label
             if cells.sum() and opening[cells].mean() >= 0.5:
                 stairwells.add(room.id)
