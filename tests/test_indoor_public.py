@@ -7,8 +7,9 @@ What holds: one storey, 0 to 3 m; the 18 rooms with 0.93 m doorways (offices, si
 washrooms) each found with an IoU of at least 0.95, and each doorway within 0.1 m and 0.1 m of
 width. What does not: the wards and halls behind the 1.5 m bed doorways and the interior
 windows (3.6 m openings over 0.96 m sills, frames without glass) are one space with the
-corridor, since ``DOOR_MAX`` is 1.4 m and a sill is as low as furniture; the two stores by
-the stairs take in the stairs' landing (the truth leaves stairs out).
+corridor, since ``DOOR_MAX`` is 1.4 m and a sill is as low as furniture (``door_max`` 1.7
+parts the rooms behind bed doorways alone); the two stores by the stairs take in the stairs'
+landing (the truth leaves stairs out).
 """
 
 from __future__ import annotations
@@ -68,12 +69,12 @@ def test_doorways_are_found(found: tuple[Interior, PlanScore]) -> None:
 
 
 def test_wide_doorways_part_rooms_with_a_wider_door_max(cloud: np.ndarray) -> None:
-    """With ``door_max`` 1.7 m the rooms behind 1.5 m doorways alone are parted (IoU >=
-    0.95); the washrooms, 1.36 m wide, are then narrower than a door and lost into the
-    wards."""
+    """With ``door_max`` 1.7 m the rooms behind 1.5 m doorways are parted too (IoU >= 0.95),
+    and the washrooms, 1.36 m wide, narrower than such a door, are still rooms of their own
+    (parted at their 0.93 m doors: ``rooms.NARROW``)."""
     score = score_plan(load_plan("aws_hospital"), find_interior(cloud, door_max=1.7))
     assert min(score.iou[r] for r in WIDE) >= 0.95
-    assert max(score.iou[r] for r in ("w_wc_s", "w_wc_n", "e_wc_s", "e_wc_n")) < 0.1
+    assert min(score.iou[r] for r in ("w_wc_s", "w_wc_n", "e_wc_s", "e_wc_n")) >= 0.9
 
 
 @pytest.mark.xfail(strict=True, reason="1.5 m bed doorways are wider than DOOR_MAX (1.4 m) "

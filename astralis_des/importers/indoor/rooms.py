@@ -1,14 +1,16 @@
 """A storey's free space cut into rooms, and what each room is.
 
 Rooms meet at doors, and a door is narrow: every free cell's distance to the nearest wall
-(scipy's Euclidean distance transform) is at most half a door's width in a doorway and more
-in the middle of a room. So the cells farther than ``door_max / 2`` from any wall fall apart
-into one piece per room (the erosion that parts rooms at their doors), and a watershed from
-those pieces over the distance, downhill (scikit-image's), regrows each to its walls and up to
-the middle of its doorways. A passage wider than ``door_max`` keeps both sides one room (an
-open-plan space, an L-shaped room). Free parts no piece reached (a room narrower than a door)
-are rooms of their own when large enough; pieces smaller than ``min_area`` join the neighbour
-they share most boundary with.
+(scipy's Euclidean distance transform) is at most half a door's width in a doorway and more in
+the middle of a room. So the cells farther than ``door_max / 2`` from any wall fall apart into
+one piece per room (the erosion that parts rooms at their doors); a room narrower than
+``door_max`` (a washroom, a narrow corridor) has no such piece, and gets the piece of its cells
+farther than ``NARROW / 2`` when that piece holds none of the others (it is parted from them by
+a door narrower than itself); and a watershed from those pieces over the distance, downhill
+(scikit-image's), regrows each to its walls and up to the middle of its doorways. A passage
+wider than ``door_max`` keeps both sides one room (an open-plan space, an L-shaped room). Free
+parts no piece reached (a room narrower than a door) are rooms of their own when large enough;
+pieces smaller than ``min_area`` join the neighbour they share most boundary with.
 
 A room's kind: a **corridor** is long and narrow (its median width along its skeleton at most
 ``CORRIDOR_WIDTH``, its area at least ``ELONGATION`` squares of that width) with at least
@@ -29,6 +31,7 @@ from astralis_des.importers.indoor.plan import BoolArray, Plan
 IntArray = NDArray[np.int64]
 DOOR_MAX = 1.4  # m, the widest passage that still parts two rooms
 MIN_DOOR = 0.4  # m, the narrowest: thinner free strips are dropped
+NARROW = 1.1  # m: a room this wide or wider, narrower than ``DOOR_MAX``, is parted at its doors
 MIN_AREA = 1.0  # m², the smallest room
 CORRIDOR_WIDTH = 3.0  # m
 ELONGATION = 3.0
@@ -72,6 +75,14 @@ def segment(free: BoolArray, cell: float, door_max: float = DOOR_MAX,
     free = ndimage.binary_opening(free, structure=disk(radius).astype(bool))
     distance = ndimage.distance_transform_edt(free) * cell
     markers, count = ndimage.label(distance > door_max / 2)
+    narrow, more = ndimage.label(distance > NARROW / 2)  # rooms narrower than a wide door
+    if more:
+        alone = np.ones(more + 1, dtype=bool)
+        alone[np.unique(narrow[markers > 0])] = False
+        alone[0] = False
+        extra, _ = ndimage.label(alone[narrow])
+        markers = np.where(extra > 0, extra + count, markers)
+        count = int(markers.max())
     labels = np.asarray(watershed(-distance, markers, mask=free), dtype=np.int64)
     rest, more = ndimage.label(free & (labels == 0))
     if more:
