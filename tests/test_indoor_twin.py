@@ -155,6 +155,10 @@ def test_a_corrected_world_is_checked_line_by_line(twin: tuple[Path, str],
     assert err.value.line == line_of(lonely, "id: A.1.2.1,")
     code, _, err_text = run_cli("validate", str(lonely))
     assert code == 2 and len(err_text.strip().splitlines()) == 1
+    assert f"{lonely}:{err.value.line}: interior.places[" in err_text
+    assert "no door leads into 'A.1.2.1'" in err_text
+    code, out, _ = run_cli("validate", str(path))
+    assert code == 0 and "world 'a', 18 rooms in 6 segments; an interior of 3 storeys" in out
 
 
 def test_a_scan_with_no_storey_is_refused_in_one_line(tmp_path: Path) -> None:

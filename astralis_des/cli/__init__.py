@@ -77,8 +77,9 @@ def _parser() -> argparse.ArgumentParser:
                         help="ROS 2 messages and the decisions as JSON (the only format)")
     export.add_argument("--mission", help="the run's mission file (default: "
                         "missions/<name>.yaml)")
-    val = sub.add_parser("validate", help="check a mission file without running it")
-    val.add_argument("mission", help="mission YAML file")
+    val = sub.add_parser("validate", help="check a mission file without running it, or a "
+                         "world file (one that has a site)")
+    val.add_argument("mission", help="mission or world YAML file")
     add_world_parser(sub)
     _add_study_parsers(sub)
     from astralis_des.cli_api import API_COMMANDS, add_api_parsers
@@ -252,12 +253,29 @@ def _export(args: argparse.Namespace) -> int:
 @command("validate")
 def _validate(args: argparse.Namespace) -> int:
     from astralis_des.mission.loader import load_mission
+    from astralis_des.yamlio import load_yaml
 
+    data = load_yaml(Path(args.mission)).data
+    if isinstance(data, dict) and "site" in data and "team" not in data:
+        return _validate_world(Path(args.mission))
     mission = load_mission(args.mission)
     search = (f"{len(mission.searched_rooms())} rooms to search" if mission.spec.assignment.auto
               else "no rooms searched but those commanded (assignment.auto is false)")
     print(f"ok: {args.mission}: mission '{mission.name}', {len(mission.spec.team)} agents, "
           f"{search} in world '{mission.world.name}'")
+    return 0
+
+
+def _validate_world(path: Path) -> int:
+    """A world file read, checked and built as a mission would: its rooms and segments."""
+    from astralis_des.world.build import read_world
+
+    world = read_world(path)
+    inner = (f"; an interior of {len(world.interior.storeys)} storeys, "
+             f"{len(world.interior.openings)} doors, {len(world.interior.stairs)} stairs"
+             if world.interior is not None else "")
+    print(f"ok: {path}: world '{world.name}', {len(world.rooms)} rooms in "
+          f"{len(world.segments)} segments{inner}")
     return 0
 
 

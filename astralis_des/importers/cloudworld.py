@@ -61,8 +61,8 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions, fmt: str) -> Buil
     origin = found.lo[:2] - opts.margin
     extent = found.hi[:2] - origin + opts.margin
     shape = cells_across(extent, voxel)
-    fill = opts.fill if opts.fill != "auto" else ("columns" if fmt in ("las", "laz") else
-                                                  "none")
+    aerial = fmt in ("las", "laz") and not opts.indoor
+    fill = opts.fill if opts.fill != "auto" else ("columns" if aerial else "none")
     built = build(cloud, found, ground, origin, shape, voxel, fill, opts, rng)
     interior = None
     if opts.indoor and built.points is not None:

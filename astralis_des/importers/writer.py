@@ -114,11 +114,13 @@ def _dump(doc: dict[str, object]) -> str:
 
 
 def _header(built: Built, source: Path, command: str) -> str:
+    found = ("# The interior (storeys, rooms, doors, stairs) was found in it: correct it here,\n"
+             "# and check it with astralis validate." if built.interior is not None else
+             "# Search areas are boxes: edit, add or remove them.")
     lines = [f"# A digital twin imported from {source.name} ({built.kind}) by:",
              f"#   {command}",
              "# Geometry lives beside this file (blocks, mesh, cloud); re-running the command",
-             "# rewrites them and this file. Search areas are boxes: edit, add or remove them.",
-             ""]
+             "# rewrites them and this file.", *found.split("\n"), ""]
     return "\n".join(lines)
 
 
@@ -141,8 +143,7 @@ def interior_text(built: Built) -> str:
     section = built.interior
     head = {k: v for k, v in section.items() if k not in ("storeys", "places", "doors",
                                                           "stairs")}
-    lines = ["interior:  # found in the scan: places GROUP.STOREY.SEGMENT.ROOM (passages: "
-             "segment 0)"]
+    lines = ["interior:  # places GROUP.STOREY.SEGMENT.ROOM (corridors, stairwells: segment 0)"]
     lines += [f"  {k}: {v}" for k, v in head.items()]
     for key in ("storeys", "places", "doors", "stairs"):
         items = section.get(key) or []

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from astralis_des.sinks import paths
+from astralis_des.sinks.looks import interior_places
 from astralis_des.world.model import World
 
 LOW, HIGH = np.array([70, 110, 160]), np.array([235, 225, 150])  # block colours by height
@@ -27,9 +28,25 @@ def log_imported(rr: Any, rec: Any, world: World) -> None:
     if imported is None:
         return
     if imported.vertices is not None and imported.faces is not None:
-        rec.log(paths.WORLD_MESH, rr.Mesh3D(vertex_positions=imported.vertices,
-                                            triangle_indices=imported.faces,
-                                            albedo_factor=MESH_COLOR), static=True)
+        centres = imported.vertices[imported.faces].mean(axis=1)
+        for path, rows in _by_storey(world, centres, paths.WORLD_MESH, "mesh"):
+            rec.log(path, rr.Mesh3D(vertex_positions=imported.vertices,
+                                    triangle_indices=imported.faces[rows],
+                                    albedo_factor=MESH_COLOR), static=True)
     if imported.cloud is not None and len(imported.cloud):
-        rec.log(paths.WORLD_CLOUD, rr.Points3D(imported.cloud, colors=imported.cloud_colors,
-                                               radii=0.08), static=True)
+        colors = imported.cloud_colors
+        for path, rows in _by_storey(world, imported.cloud, paths.WORLD_CLOUD, "cloud"):
+            rec.log(path, rr.Points3D(imported.cloud[rows], colors=None if colors is None
+                                      else colors[rows], radii=0.08), static=True)
+
+
+def _by_storey(world: World, centres: np.ndarray, whole: str, what: str
+               ) -> list[tuple[str, np.ndarray]]:
+    """The rows of ``centres`` by the interior's storey they are on (``world/G/2/mesh``), so
+    that the storeys over the robots and the roof can be hidden; all at ``whole`` in a world
+    with no interior."""
+    if world.interior is None:
+        return [(whole, np.arange(len(centres)))]
+    places = np.array(interior_places(world, centres), dtype=object)
+    return [(paths.world_part(str(place), what), np.flatnonzero(places == place))
+            for place in sorted(set(places.tolist()))]

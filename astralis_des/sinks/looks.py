@@ -63,7 +63,24 @@ def place_of(world: World, box: Box) -> str:
         if lo[0] - 0.5 <= centre[0] <= hi[0] + 0.5 and lo[1] - 0.5 <= centre[1] <= hi[1] + 0.5:
             storey = math.floor((centre[2] + 0.3) / b.floor_height) + 1
             return f"{bid}/roof" if storey > b.floors else f"{bid}/{max(storey, 1)}"
-    return "site"
+    return interior_places(world, np.array([centre]))[0]
+
+
+def interior_places(world: World, centres: np.ndarray) -> list[str]:
+    """For each of ``centres`` (``(N, 3)``) in the interior's bounds, ``G/2`` (its storey: the
+    highest floor at most 0.3 m over it, so a storey's ceiling goes with the storey above) or
+    ``G/roof`` (the top 0.3 m); ``site`` elsewhere."""
+    inner = world.interior
+    out = np.full(len(centres), "site", dtype=object)
+    if inner is None or not len(centres):
+        return list(out)
+    lo, hi = np.array(inner.footprint.lo) - 0.5, np.array(inner.footprint.hi) + 0.5
+    inside = np.all((centres[:, :2] >= lo[:2]) & (centres[:, :2] <= hi[:2]), axis=1)
+    storey = np.maximum(np.searchsorted(np.array(inner.storeys), centres[:, 2] + 0.3,
+                                        side="right"), 1)
+    out[inside] = [f"{inner.group}/{n}" for n in storey[inside]]
+    out[inside & (centres[:, 2] > inner.footprint.hi[2] - 0.3)] = f"{inner.group}/roof"
+    return list(out)
 
 
 def by_place(world: World, boxes: Sequence[Box]) -> dict[str, list[int]]:

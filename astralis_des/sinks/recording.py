@@ -218,16 +218,19 @@ class RerunRecorder:
 
 def above(world: World, shown: Sequence[Any]) -> list[str]:
     """The storeys (and roofs) above the highest storey of the ``shown`` rooms in each
-    building (all of a building with none): the 3-D view leaves them out, so that it looks
+    building or interior (all of one with none): the 3-D view leaves them out, so that it looks
     into the storey where the target was found (or where the search began)."""
     top: dict[str, int] = {}
     for room in shown:
-        if room.building in world.buildings:
+        if room.building in world.indoors:
             top[room.building] = max(top.get(room.building, 0), room.floor)
+    storeys = {bid: b.floors for bid, b in world.buildings.items()}
+    if world.interior is not None:
+        storeys[world.interior.group] = len(world.interior.storeys)
     hidden = []
-    for bid, building in world.buildings.items():
-        highest = top.get(bid, building.floors)
-        hidden += [f"{bid}/{n}" for n in range(highest + 1, building.floors + 1)]
+    for bid, floors in storeys.items():
+        highest = top.get(bid, floors)
+        hidden += [f"{bid}/{n}" for n in range(highest + 1, floors + 1)]
         hidden.append(f"{bid}/roof")
     return hidden
 
