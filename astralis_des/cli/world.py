@@ -119,6 +119,9 @@ def _add_import_parser(world_sub: Any) -> None:
                      "(instead of --areas)")
     imp.add_argument("--group", default="A", help="--indoor: the building's id, the first part "
                      "of its rooms' ids (default: A)")
+    imp.add_argument("--door-max", type=float, default=1.4, help="--indoor: the widest "
+                     "passage, in m, that still parts two rooms (default: 1.4; wider openings "
+                     "join them, as an open-plan space)")
 
 
 @world_command("rooms")
@@ -162,7 +165,7 @@ def _world_import(args: argparse.Namespace) -> int:
         area_size=args.area_size, margin=args.margin, cloud_points=args.cloud_points,
         seed=args.seed, name=args.name, format=args.format, partial=args.partial,
         max_points=args.max_points, keep_strays=args.keep_strays, indoor=args.indoor,
-        group=args.group)
+        group=args.group, door_max=args.door_max)
     command_line = " ".join(["astralis world import", *sys.argv[3:]]) if \
         sys.argv[1:3] == ["world", "import"] else None
     console = Console(highlight=False, stderr=True, soft_wrap=True)  # a line is one line

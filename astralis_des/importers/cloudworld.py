@@ -66,7 +66,8 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions, fmt: str) -> Buil
     built = build(cloud, found, ground, origin, shape, voxel, fill, opts, rng)
     interior = None
     if opts.indoor and built.points is not None:
-        interior, _ = indoor_section(built.points, opts.group, path, notes)  # floor ~ 0
+        interior, _ = indoor_section(built.points, opts.group, path, notes,
+                                     opts.door_max)  # floor ~ 0
         built.points = None
         built.boxes = outside_interior(built.boxes, voxel, interior)
     areas = [] if opts.indoor else cloud_areas(built, shape, voxel, found, opts, path, notes)

@@ -13,6 +13,7 @@ import numpy as np
 
 from astralis_des.errors import InputError
 from astralis_des.importers.indoor import find_interior
+from astralis_des.importers.indoor.rooms import DOOR_MAX
 from astralis_des.importers.indoor.twin import twin_section
 from astralis_des.world.interior_walls import interior_bounds
 from astralis_des.world.spec import InteriorSpec
@@ -21,18 +22,20 @@ log = logging.getLogger(__name__)
 TURN = 1.0  # degrees: walls further off the axes are refused (the world's rooms are boxes)
 
 
-def indoor_section(points: np.ndarray, group: str, path: Path,
-                   notes: list[str]) -> tuple[dict[str, Any], float]:
+def indoor_section(points: np.ndarray, group: str, path: Path, notes: list[str],
+                   door_max: float = DOOR_MAX) -> tuple[dict[str, Any], float]:
     """The ``interior:`` section of ``points`` (``(N, 3)``, world frame), its lowest floor at
-    ``z = 0``, and the height that floor was found at (the world is lowered by it)."""
+    ``z = 0``, and the height that floor was found at (the world is lowered by it); passages up
+    to ``door_max`` wide part rooms."""
     try:
-        found = find_interior(np.asarray(points, dtype=float))
+        found = find_interior(np.asarray(points, dtype=float), door_max=door_max)
         turn = math.degrees(found.heading)
         if abs(turn) > TURN:
             raise InputError(f"--indoor: the walls run at {turn:.1f} degrees to the scan's x "
                              "axis; turn the scan so they run along x and y", file=path)
         if found.heading != 0.0:  # nearly along the axes: planned along them
-            found = find_interior(np.asarray(points, dtype=float), heading=0.0)
+            found = find_interior(np.asarray(points, dtype=float), heading=0.0,
+                                  door_max=door_max)
     except ValueError as exc:
         raise InputError(f"--indoor: {exc}", file=path) from None
     if not found.storeys:

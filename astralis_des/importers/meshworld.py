@@ -65,7 +65,7 @@ def mesh_world(mesh: Mesh, path: Path, opts: ImportOptions) -> Built:
     interior = None
     if opts.indoor:  # storeys, rooms and doors, the lowest floor brought to z = 0
         points = surface_points(vertices, faces, INDOOR_SPACING, seed=opts.seed)
-        interior, floor = indoor_section(points, opts.group, path, notes)
+        interior, floor = indoor_section(points, opts.group, path, notes, opts.door_max)
         origin[2] += floor
         vertices[:, 2] -= floor
     tri = triangles(vertices, faces)

@@ -45,6 +45,7 @@ class ImportOptions:
     keep_strays: bool = False  # keep points far from the rest of the cloud
     indoor: bool = False  # find storeys, rooms and doors (an indoor scan or model)
     group: str = "A"  # the id of the building an indoor import finds
+    door_max: float = 1.4  # m, the widest passage that still parts two rooms (indoor)
 
     def check(self) -> None:
         """Refuse nonsense at the edge, naming the option."""
@@ -58,7 +59,7 @@ class ImportOptions:
                                   ("--collision", self.collision, COLLISIONS)):
             need(value in valid, key, f"'{value}' is not one of: {', '.join(valid)}")
         for key, number in (("--voxel", self.voxel), ("--scale", self.scale),
-                            ("--area-size", self.area_size)):
+                            ("--area-size", self.area_size), ("--door-max", self.door_max)):
             if number is not None:
                 need(math.isfinite(number) and number > 0, key,
                      f"must be a positive number, got {number:g}")

@@ -16,6 +16,10 @@ resident set, from ``wait4``) is its own. Three parts:
   this script and not timed: imported in <= 60 s and <= 1.5 GB, printed beside the time laspy
   takes merely to read it, in the same run.
 - **autzen_trim.laz**: no slower than 2 s (the whole process); and two meshes.
+- **An indoor cloud** of ``--indoor-points`` points (5 million: building A of the default
+  world, three storeys sampled on its faces as a scan from inside sees them, with furniture),
+  written as LAZ, imported with ``--indoor`` (issue 42): <= 60 s and <= 2 GB, every room of
+  the building found, printed beside the time laspy takes to read it.
 """
 
 from __future__ import annotations
@@ -186,6 +190,47 @@ def synthetic(points: int, limit: float) -> None:
         print("  " + " ".join(result.out.split())[:300])
 
 
+def indoor(points: int, limit: float) -> None:
+    print(f"\n## An indoor LAZ of {points:,} points (--indoor)\n")
+    with tempfile.TemporaryDirectory(prefix="bench-import-") as tmp:
+        laz = Path(tmp) / "building_a.laz"
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, __file__, "--make-indoor", str(laz), "--indoor-points",
+                        str(points)], check=True, cwd=ROOT)
+        print(f"(made a {laz.stat().st_size / 1e6:,.0f} MB LAZ in "
+              f"{time.perf_counter() - t0:.1f} s, not counted)")
+        read = run([sys.executable, "-c", READ_ONLY, str(laz)], limit)
+        result = run(import_args(laz, Path(tmp) / "w" / "a.yaml", "--indoor"), limit)
+        said = " ".join(result.out.split())
+        rooms = said.split(" rooms,")[0].rsplit(" ", 1)[-1] if " rooms," in said else "?"
+        ok = result.outcome == "world" and result.seconds <= 60 and result.peak_gb <= 2.0 \
+            and rooms == "18"
+        print(f"- laspy reads it: {read.seconds:.1f} s with start-up, peak {read.peak_gb:.2f} GB")
+        print(f"- astralis world import --indoor: {result.seconds:.1f} s, peak "
+              f"{result.peak_gb:.2f} GB, {result.seconds / read.seconds:.1f}x the read's "
+              f"process; {rooms} rooms of 18; goal <= 60 s, <= 2 GB, 18 rooms: "
+              f"{'ok' if ok else 'MISSED'} ({result.outcome})")
+        print("  " + said[:300])
+
+
+def indoor_cloud(path: Path, points: int) -> None:
+    """Building A of the default world sampled on its faces (tests/indoor_scenes.py), about
+    ``points`` points, as LAZ."""
+    import laspy
+
+    sys.path.insert(0, str(ROOT / "tests"))
+    from indoor_scenes import building_a, face_cloud
+
+    scene = building_a()
+    probe = len(face_cloud(scene, 0.1))
+    cloud = face_cloud(scene, 0.1 * math.sqrt(probe / points), seed=1)
+    header = laspy.LasHeader(point_format=0, version="1.2")
+    header.scales, header.offsets = [0.001, 0.001, 0.001], [0.0, 0.0, 0.0]
+    las = laspy.LasData(header)
+    las.x, las.y, las.z = cloud[:, 0], cloud[:, 1], cloud[:, 2]
+    las.write(path)
+
+
 def reference(skip_meshes: bool, limit: float) -> None:
     print("\n## Reference files\n")
     with tempfile.TemporaryDirectory(prefix="bench-import-") as tmp:
@@ -258,15 +303,23 @@ def main() -> None:
     parser.add_argument("--skip-corpus", action="store_true")
     parser.add_argument("--skip-synthetic", action="store_true")
     parser.add_argument("--skip-meshes", action="store_true")
+    parser.add_argument("--indoor-points", type=int, default=5_000_000)
+    parser.add_argument("--skip-indoor", action="store_true")
     parser.add_argument("--make", help=argparse.SUPPRESS)  # write the synthetic cloud only
+    parser.add_argument("--make-indoor", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.make:
         synthetic_cloud(Path(args.make), args.points)
+        return
+    if args.make_indoor:
+        indoor_cloud(Path(args.make_indoor), args.indoor_points)
         return
     print(f"# Import benchmark ({os.cpu_count()} cores; every import a fresh process)")
     reference(args.skip_meshes, 120.0)
     if not args.skip_corpus:
         corpus(args.corpus, args.limit)
+    if not args.skip_indoor:
+        indoor(args.indoor_points, 600.0)
     if not args.skip_synthetic:
         synthetic(args.points, max(600.0, math.ceil(args.points / 1e5)))
 
