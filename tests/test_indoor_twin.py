@@ -171,3 +171,27 @@ def test_a_scan_with_no_storey_is_refused_in_one_line(tmp_path: Path) -> None:
     assert code == 2
     assert "--indoor: no storey found" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "f.yaml").exists()
+
+
+def test_a_scan_turned_off_the_axes_is_turned_back(tmp_path: Path) -> None:
+    """Building A scanned with its walls at 23 degrees to the scan's axes: the import turns it
+    back (heading 23), finds the same 18 rooms and ids, and a room's centre in the file's
+    frame is the world's turned by the heading, plus the offset."""
+    angle = np.radians(23.0)
+    turn = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    points = face_cloud(building_a(), 0.08)
+    points[:, :2] = points[:, :2] @ turn.T
+    code, out, err = run_cli("world", "import", str(write_ply(tmp_path / "t.ply", points)),
+                             "-o", str(tmp_path / "t.yaml"), "--indoor")
+    assert code == 0, err
+    assert "turned by -23.0 degrees" in " ".join(out.split())
+    doc = yaml.safe_load((tmp_path / "t.yaml").read_text())
+    assert doc["interior"]["heading"] == pytest.approx(23.0, abs=0.1)
+    world, original = load_world(tmp_path / "t.yaml"), load_world(ROOT / "worlds" /
+                                                                  "urban_default.yaml")
+    want = sorted(r for r in original.rooms if r.startswith("A."))
+    assert sorted(world.rooms) == want
+    for rid in want:
+        mine = turn @ np.array(world.rooms[rid].box.center[:2]) + offset(tmp_path / "t.yaml")
+        theirs = turn @ np.array(original.rooms[rid].box.center[:2])
+        assert np.allclose(mine, theirs, atol=0.2), rid

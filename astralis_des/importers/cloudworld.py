@@ -37,10 +37,15 @@ from astralis_des.importers.ground import (
     grid_size,
     ground_of,
 )
-from astralis_des.importers.indoor_world import indoor_section, outside_interior
+from astralis_des.importers.indoor_world import (
+    HEADING_SAMPLE,
+    indoor_heading,
+    indoor_section,
+    outside_interior,
+)
 from astralis_des.importers.options import Built, ImportOptions
 from astralis_des.importers.source import Cloud
-from astralis_des.importers.survey import Survey, survey
+from astralis_des.importers.survey import Survey, sample, survey, turn_about, turned
 from astralis_des.importers.voxels import MAX_INDEX, cells_across
 
 log = logging.getLogger(__name__)
@@ -55,6 +60,9 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions, fmt: str) -> Buil
     except InputError as exc:
         raise InputError(exc.message, file=path, key=exc.key) from None
     notes = [*cloud.notes, f"units: {found.metres.frame.note}", *found.notes]
+    heading = indoor_heading(sample(found, HEADING_SAMPLE), path) if opts.indoor else 0.0
+    if heading:  # an indoor scan is turned so that its walls run along x and y
+        found = turned(found, -heading)
     voxel = _voxel(found, opts, path, notes)
     rng = np.random.default_rng(opts.seed)
     ground = _ground(cloud, found, opts, path, rng)
@@ -67,12 +75,19 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions, fmt: str) -> Buil
     interior = None
     if opts.indoor and built.points is not None:
         interior, _ = indoor_section(built.points, opts.group, path, notes,
-                                     opts.door_max)  # floor ~ 0
+                                     opts.door_max, heading)  # its floor: the ground
         built.points = None
         built.boxes = outside_interior(built.boxes, voxel, interior)
     areas = [] if opts.indoor else cloud_areas(built, shape, voxel, found, opts, path, notes)
     frame = found.metres.frame
-    file_xy = frame.file_xy(origin if frame.projection is None else origin / opts.scale)
+    corner = origin
+    if found.metres.turn is not None:  # the origin, back in the file's frame
+        angle, pivot = found.metres.turn
+        corner = turn_about(np.array([[*origin, 0.0]]), -angle, pivot)[0, :2]
+        if frame.wkt is not None:
+            notes.append("not georeferenced: the world's x axis runs along the walls, "
+                         "not east")
+    file_xy = frame.file_xy(corner if frame.projection is None else corner / opts.scale)
     offset = (file_xy[0], file_xy[1], float(np.median(ground.heights) / frame.vertical))
     classes = cloud.classification
     classified = found.ground_class / found.kept if classes is not None and classes.any() \
@@ -83,7 +98,7 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions, fmt: str) -> Buil
               "scale": round(frame.horizontal, 9), "up": "z", "offset": offset,
               "ground": ground.method, "ground_share": round(share, 4),
               "relief": round(ground.relief, 2),
-              "origin": _geodetic(frame.wkt, offset, frame.vertical)}
+              "origin": None if heading else _geodetic(frame.wkt, offset, frame.vertical)}
     if found.strays:
         source["strays"] = found.strays
     if cloud.held is not None and cloud.held != len(cloud):

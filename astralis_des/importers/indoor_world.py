@@ -12,30 +12,43 @@ from typing import Any
 import numpy as np
 
 from astralis_des.errors import InputError
-from astralis_des.importers.indoor import find_interior
+from astralis_des.importers.indoor import find_interior, find_storeys
+from astralis_des.importers.indoor.interior import walls_heading
 from astralis_des.importers.indoor.rooms import DOOR_MAX
 from astralis_des.importers.indoor.twin import twin_section
 from astralis_des.world.interior_walls import interior_bounds
 from astralis_des.world.spec import InteriorSpec
 
 log = logging.getLogger(__name__)
-TURN = 1.0  # degrees: walls further off the axes are refused (the world's rooms are boxes)
+TURN = 0.2  # degrees: a scan whose walls run further off its axes is turned along them
+HEADING_SAMPLE = 1_000_000  # points the walls' heading is found from
+
+
+def indoor_heading(points: np.ndarray, path: Path) -> float:
+    """How far (radians) the walls of ``points`` (``(N, 3)``, metres) run off the axes, 0 when
+    within ``TURN``: the import turns the scan by minus that, so that the world's rooms lie
+    along x and y. A cloud with no storey is refused here, before anything is built."""
+    pts = np.asarray(points[:: max(1, len(points) // HEADING_SAMPLE)], dtype=float)
+    try:
+        storeys = find_storeys(pts)
+    except ValueError as exc:
+        raise InputError(f"--indoor: {exc}", file=path) from None
+    if not storeys:
+        raise InputError("--indoor: no storey found (no floor under a ceiling with walls "
+                         "between): is this an indoor scan?", file=path)
+    heading = walls_heading(pts, storeys)
+    return heading if abs(math.degrees(heading)) > TURN else 0.0
 
 
 def indoor_section(points: np.ndarray, group: str, path: Path, notes: list[str],
-                   door_max: float = DOOR_MAX) -> tuple[dict[str, Any], float]:
-    """The ``interior:`` section of ``points`` (``(N, 3)``, world frame), its lowest floor at
-    ``z = 0``, and the height that floor was found at (the world is lowered by it); passages up
-    to ``door_max`` wide part rooms."""
+                   door_max: float = DOOR_MAX, heading: float = 0.0
+                   ) -> tuple[dict[str, Any], float]:
+    """The ``interior:`` section of ``points`` (``(N, 3)``, world frame, its walls along the
+    axes: the scan turned by ``-heading`` radians, :func:`indoor_heading`), its lowest floor
+    at ``z = 0``, and the height that floor was found at (the world is lowered by it);
+    passages up to ``door_max`` wide part rooms."""
     try:
-        found = find_interior(np.asarray(points, dtype=float), door_max=door_max)
-        turn = math.degrees(found.heading)
-        if abs(turn) > TURN:
-            raise InputError(f"--indoor: the walls run at {turn:.1f} degrees to the scan's x "
-                             "axis; turn the scan so they run along x and y", file=path)
-        if found.heading != 0.0:  # nearly along the axes: planned along them
-            found = find_interior(np.asarray(points, dtype=float), heading=0.0,
-                                  door_max=door_max)
+        found = find_interior(np.asarray(points, dtype=float), heading=0.0, door_max=door_max)
     except ValueError as exc:
         raise InputError(f"--indoor: {exc}", file=path) from None
     if not found.storeys:
@@ -43,16 +56,18 @@ def indoor_section(points: np.ndarray, group: str, path: Path, notes: list[str],
                          "between): is this an indoor scan?", file=path)
     lowest = found.storeys[0].z
     twin = twin_section(found, group, [round(s.z - lowest, 2) for s in found.storeys])
+    twin.section["heading"] = round(math.degrees(heading), 2)
     notes.extend(twin.notes)
     places: list[dict[str, Any]] = twin.section["places"]  # type: ignore[assignment]
     rooms = [p for p in places if p["kind"] in ("room", "hall")]
     if not rooms:
         raise InputError(f"--indoor: {len(found.storeys)} storeys but no room a robot fits "
                          "in (walls not closed? the scan too sparse?)", file=path)
+    turn = (f"; the scan turned by {-math.degrees(heading):.1f} degrees so that its walls "
+            "run along x and y" if heading else "")
     notes.append(f"indoor: {len(found.storeys)} storeys, {len(rooms)} rooms, "
                  f"{len(places) - len(rooms)} corridors and stairwells, "
-                 f"{len(twin.section['doors'])} doors (walls at "  # type: ignore[arg-type]
-                 f"{math.degrees(found.heading):.1f} degrees)")
+                 f"{len(twin.section['doors'])} doors{turn}")  # type: ignore[arg-type]
     return twin.section, lowest
 
 

@@ -18,7 +18,11 @@ from scipy import ndimage
 from astralis_des.errors import InputError
 from astralis_des.importers.areas import Area, Level, place_areas
 from astralis_des.importers.indoor.surface import surface_points
-from astralis_des.importers.indoor_world import indoor_section, outside_interior
+from astralis_des.importers.indoor_world import (
+    indoor_heading,
+    indoor_section,
+    outside_interior,
+)
 from astralis_des.importers.mesh import (
     choose_up,
     closed_faces,
@@ -30,6 +34,7 @@ from astralis_des.importers.mesh import (
 )
 from astralis_des.importers.options import Built, ImportOptions
 from astralis_des.importers.source import Mesh, finite_rows, unit_scale
+from astralis_des.importers.survey import turn_about
 from astralis_des.importers.voxels import boxes_from_indices, grid_shape, unique_rows
 from astralis_des.world.geometry import FloatArray
 
@@ -57,15 +62,21 @@ def mesh_world(mesh: Mesh, path: Path, opts: ImportOptions) -> Built:
                          "infinite coordinates dropped)" if dropped else ""), file=path)
     up = choose_up(mesh, opts.up)
     scale = unit_scale(opts.units, None) * opts.scale
-    turned = to_z_up(np.where(good[:, None], mesh.vertices, 0.0), up) * scale
+    upright = to_z_up(np.where(good[:, None], mesh.vertices, 0.0), up) * scale
     used = np.unique(faces)
-    origin = turned[used].min(axis=0) - np.array([opts.margin, opts.margin, 0.0])
-    vertices = turned - origin
+    heading, pivot = 0.0, upright[used].mean(axis=0)
+    if opts.indoor:  # turned so that the walls run along x and y
+        heading = indoor_heading(surface_points(upright, faces, INDOOR_SPACING, seed=opts.seed),
+                                 path)
+        upright = turn_about(upright, -heading, pivot) if heading else upright
+    origin = upright[used].min(axis=0) - np.array([opts.margin, opts.margin, 0.0])
+    vertices = upright - origin
     notes: list[str] = []
     interior = None
     if opts.indoor:  # storeys, rooms and doors, the lowest floor brought to z = 0
         points = surface_points(vertices, faces, INDOOR_SPACING, seed=opts.seed)
-        interior, floor = indoor_section(points, opts.group, path, notes, opts.door_max)
+        interior, floor = indoor_section(points, opts.group, path, notes, opts.door_max,
+                                         heading)
         origin[2] += floor
         vertices[:, 2] -= floor
     tri = triangles(vertices, faces)
@@ -89,7 +100,8 @@ def mesh_world(mesh: Mesh, path: Path, opts: ImportOptions) -> Built:
     collision = opts.collision if opts.collision != "auto" else \
         "boxes" if opts.indoor else "concave"
     parts = _convex_parts(vertices, faces) if collision == "convex" else None
-    back = _to_source(origin / scale, up)
+    corner = turn_about(origin[None, :], heading, pivot)[0] if heading else origin
+    back = _to_source(corner / scale, up)  # the origin in the file's frame
     source = {"kind": "mesh", "faces": len(mesh.faces), "dropped": dropped,
               "units": f"{opts.units} (given)" if opts.units != "auto" else
               "m (a mesh has no units: metres assumed)", "scale": round(scale, 9), "up": up,

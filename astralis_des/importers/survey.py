@@ -36,6 +36,7 @@ class Metres:
         self.scale = scale
         self.projected: NDArray[np.float32] | None = None
         self.origin = np.zeros(3)
+        self.turn: tuple[float, FloatArray] | None = None  # radians about a pivot (xy)
         if frame.projection is not None:
             self._project()
 
@@ -52,10 +53,12 @@ class Metres:
             self.projected[lo:lo + len(m)] = m - self.origin
 
     def at(self, lo: int, hi: int) -> FloatArray:
-        """Rows ``lo:hi`` in metres, float64."""
+        """Rows ``lo:hi`` in metres, float64 (turned, when :attr:`turn` says)."""
         if self.projected is not None:
-            return self.projected[lo:hi].astype(np.float64) + self.origin
-        return self.frame.metres(self.cloud.coordinates(lo, hi))
+            m = self.projected[lo:hi].astype(np.float64) + self.origin
+        else:
+            m = self.frame.metres(self.cloud.coordinates(lo, hi))
+        return m if self.turn is None else turn_about(m, *self.turn)
 
     def chunks(self) -> Iterator[tuple[int, int, FloatArray]]:
         n = len(self.cloud)
@@ -126,6 +129,35 @@ def survey(cloud: Cloud, units: str, crs: str | None, scale: float,
         if classes is not None else 0
     return Survey(metres, keep, kept, n - count, count - kept, lo_m, hi_m, space, area,
                   ground_class, notes)
+
+
+def turn_about(points: FloatArray, angle: float, pivot: FloatArray) -> FloatArray:
+    """``(N, 3)`` points turned by ``angle`` radians (anticlockwise) about the vertical line
+    through ``pivot`` (xy)."""
+    c, s = np.cos(angle), np.sin(angle)
+    x, y = points[:, 0] - pivot[0], points[:, 1] - pivot[1]
+    out = np.array(points, dtype=np.float64)
+    out[:, 0] = pivot[0] + x * c - y * s
+    out[:, 1] = pivot[1] + x * s + y * c
+    return out
+
+
+def turned(found: Survey, angle: float) -> Survey:
+    """``found`` with its points turned by ``angle`` radians about the middle of their
+    bounds: the bounds found anew (the spacing, the strays and the classes are the same)."""
+    pivot = (found.lo[:2] + found.hi[:2]) / 2
+    found.metres.turn = (angle, pivot)
+    lo_m, hi_m = np.full(3, np.inf), np.full(3, -np.inf)
+    for lo, hi, m in found.metres.chunks():
+        rows = m[found.keep[lo:hi]]
+        if len(rows):
+            lo_m, hi_m = np.minimum(lo_m, rows.min(axis=0)), np.maximum(hi_m, rows.max(axis=0))
+    return replace(found, lo=lo_m, hi=hi_m)
+
+
+def sample(found: Survey, size: int) -> FloatArray:
+    """At most ``size`` of the kept points, in metres, spread evenly through the file."""
+    return _gather(found.metres, _sample_rows(found.keep, size))
 
 
 def _on_earth(metres: Metres, lo: FloatArray, hi: FloatArray) -> None:

@@ -274,8 +274,10 @@ class InteriorSpec(Strict):
 
     group: str = Field(pattern=r"^[A-Za-z][A-Za-z0-9]*$", description="the building's letter(s)"
                        ": a mission's assignment.search names it")
-    heading: float = Field(0.0, ge=-180, le=180, description="degrees the scan was turned so "
-                           "its walls run along x and y (for the record)")
+    heading: float = Field(0.0, ge=-180, le=180, description="degrees the scan's walls ran "
+                           "off its x axis: the world is the scan turned back by it, so that "
+                           "they run along x and y (a point's xy in the file is the world's "
+                           "turned by heading, plus source.offset)")
     storeys: list[StoreySpec] = Field(min_length=1, description="lowest first")
     places: list[PlaceSpec] = Field(min_length=1, description="rooms, halls, corridors and "
                                     "stairwells")

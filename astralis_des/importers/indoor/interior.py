@@ -62,6 +62,17 @@ class Interior:
         return turned(np.atleast_2d(np.asarray(xy, dtype=float)), self.heading)
 
 
+def walls_heading(points: FloatArray, storeys: list[Storey] | tuple[Storey, ...],
+                  knee: float = KNEE, head: float = HEAD) -> float:
+    """Which way the walls of ``points`` run (radians, :func:`.heading.wall_heading`): of the
+    points between knee and head height over each of ``storeys``' floors."""
+    z = points[:, 2]
+    walls = np.zeros(len(points), dtype=bool)
+    for storey in storeys:
+        walls |= (z >= storey.z + knee) & (z <= storey.z + head)
+    return wall_heading(points[walls, :2])
+
+
 def find_interior(points: FloatArray, *, normals: FloatArray | None = None,
                   cell: float | None = None, heading: float | None = None,
                   knee: float = KNEE, head: float = HEAD,
@@ -85,11 +96,7 @@ def find_interior(points: FloatArray, *, normals: FloatArray | None = None,
                     "walls have gaps that rooms may leak through", spacing, SPARSE)
     storeys = find_storeys(points, normals)
     if heading is None:
-        z = points[:, 2]
-        walls = np.zeros(len(points), dtype=bool)
-        for storey in storeys:
-            walls |= (z >= storey.z + knee) & (z <= storey.z + head)
-        heading = wall_heading(points[walls, :2])
+        heading = walls_heading(points, storeys, knee, head)
     points = turned(points, -heading)
     if normals is not None:
         normals = turned(np.asarray(normals, dtype=float), -heading)
