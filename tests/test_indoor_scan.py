@@ -1,5 +1,5 @@
-"""Indoor analysis (issue 42) on realistic clouds: the 3-D lidar flown through building A of
-the default world and through the irregular building (``tests/indoor_scan.py``), saved as
+"""Indoor analysis (issue 42) on realistic clouds: the 3-D lidar flown through buildings A and
+B of the default world and through the irregular building (``tests/indoor_scan.py``), saved as
 LAZ and PLY and read back; and both exported as meshes (building A as OBJ and GLB, the
 irregular one as GLB), read back and sampled on their surfaces. Each: every true room
 matched by a found room with an IoU of at least 0.8, every door found within 0.3 m of its
@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from indoor_scan import flight, lidar_scan, scene_mesh, write_cloud, write_mesh
-from indoor_scenes import Scene, building_a, irregular, score
+from indoor_scenes import ROOT, Scene, building_a, irregular, score, world_building
 
 from astralis_des.importers.indoor import Interior, find_interior, surface_points
 from astralis_des.importers.las import read_las
@@ -108,6 +108,15 @@ def test_lidar_scan_of_building_a(scan_a: tuple[Scene, Interior, np.ndarray]) ->
     assert 1_000_000 < len(points) < 4_000_000
     _meets_the_goal(scene, interior)
     assert len(interior.entrances) == 1
+
+
+def test_lidar_scan_of_building_b(tmp_path: Path) -> None:
+    """The default world's other building: two storeys of three rooms off a corridor, its
+    stairwell at the west end."""
+    scene = world_building(ROOT / "worlds" / "urban_default.yaml", "B")
+    scene, interior, _ = _scanned(scene, tmp_path / "b.laz", seed=4)
+    assert [round(s.z, 2) for s in interior.storeys] == [0.0, 3.5]
+    _meets_the_goal(scene, interior)
 
 
 def test_lidar_scan_of_the_irregular_building(

@@ -1,8 +1,9 @@
 """An indoor scan or model becomes a world searched room by room (issue 42): ``astralis world
 import --indoor`` on a scan of the default world's building A, or on its model as a mesh,
-writes its storeys, rooms, doors and stairs; the twin's rooms are the original's, the paper's team searches it in both fidelities
-with the same first-round Eq. 1 assignment, and a corrected world file is checked line by
-line."""
+writes its storeys, rooms, doors and stairs; the twin's rooms are the original's, the paper's
+team searches it in both fidelities with the same first-round Eq. 1 assignment, and a corrected
+world file is checked line by line. A scan whose walls run off its axes is turned back; one
+with no storey is refused."""
 
 from __future__ import annotations
 
