@@ -196,3 +196,65 @@ def test_a_scan_turned_off_the_axes_is_turned_back(tmp_path: Path) -> None:
         mine = turn @ np.array(world.rooms[rid].box.center[:2]) + offset(tmp_path / "t.yaml")
         theirs = turn @ np.array(original.rooms[rid].box.center[:2])
         assert np.allclose(mine, theirs, atol=0.2), rid
+
+
+def test_a_room_that_is_no_rectangle_is_furnished_and_searched_inside_its_outline() -> None:
+    """The hospital's stores by the stairs take in the landing, and two rooms have niches:
+    rooms that are no rectangle. Their furniture stands inside the outline, and a UAV's spiral
+    and a walker's loop keep to it."""
+    from astralis_des.world import coverage as cov
+    from astralis_des.world.catalogue import default_catalogue
+    from astralis_des.world.geometry import inside_polygon
+    from astralis_des.world.scene import Scene
+
+    world = load_world(ROOT / "worlds" / "hospital.yaml")
+    shaped = [r for r in world.rooms.values() if r.outline]
+    assert len(shaped) == 4
+    scene = Scene(world, dict.fromkeys(world.rooms, 1.0), 3, default_catalogue())
+    scene.furnish([r.id for r in shaped])
+    for room in shaped:
+        outline = np.asarray(room.outline)
+        items = scene.clutter(room.id).in_room(room.id)
+        assert len(items) >= 2
+        centres = np.array([[*item.box.center[:2]] for item in items])
+        assert inside_polygon(centres, outline).all(), room.id
+        spiral = cov.within(cov.spiral(room.box, 1.0, margin=0.4), room.outline, 0.4)
+        walk = cov.within(cov.loop(room.box, 0.6), room.outline, 0.6)
+        for path in (spiral, walk):
+            assert len(path) >= 4 and inside_polygon(path, outline).all(), room.id
+        assert inside_polygon(np.array([room.center[:2]]), outline)[0]
+
+
+def test_routes_in_the_hospital_keep_inside_its_walls() -> None:
+    """Its hall and corridors are one place that is not convex (round the rooms in its
+    middle): from the entrance hall every kind reaches every room, and no leg of a route
+    passes through a wall."""
+    from astralis_des.world.geometry import segments_hit_boxes
+    from astralis_des.world.interior_routes import reflex_corners, visible
+
+    world = load_world(ROOT / "worlds" / "hospital.yaml")
+    walls = np.array([[s.box.lo, s.box.hi] for s in world.solids if s.kind == "wall"])
+    start = np.array([22.5, 58.0, 0.0])
+    for kind in ("uav", "ugv", "human"):
+        for room in world.rooms.values():
+            route = world.router.route(start, np.array(room.center), kind)
+            assert route is not None, (kind, room.id)
+            legs = route.copy()
+            legs[:, 2] = 0.5  # under the lintels
+            assert not segments_hit_boxes(legs[:-1], legs[1:], walls).any(), (kind, room.id)
+    square = np.array([(0, 0), (4, 0), (4, 4), (0, 4)], dtype=float)
+    ell = np.array([(0, 0), (6, 0), (6, 3), (3, 3), (3, 6), (0, 6)], dtype=float)
+    assert len(reflex_corners(square)) == 0 and len(reflex_corners(ell)) == 1
+    assert visible(np.array([[1, 1], [5, 1]]), np.array([[5, 1], [1, 5]]), ell).tolist() == \
+        [True, False]
+
+
+@pytest.mark.parametrize("seed", [1, 3, 6])
+def test_the_hospital_mission_finds_the_target_with_no_failed_task(seed: int) -> None:
+    """Other seeds of missions/hospital_search.yaml, kinematic: a patrolling bystander in a
+    room that is no rectangle once ended a run in a traceback."""
+    mission = load_mission(ROOT / "missions" / "hospital_search.yaml").with_changes(seed=seed)
+    result = Simulation(mission).run()
+    assert result.found
+    assert not [e for e in result.events if e["kind"] == "task_finished"
+                and e["status"] == "failed"]

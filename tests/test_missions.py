@@ -73,11 +73,11 @@ def test_faults_mission_fails_retries_preempts_and_recovers() -> None:
 
 def test_hospital_search_searches_the_imported_rooms() -> None:
     """The hospital's 18 rooms, found in its model, are searched room by room; the UGV finds
-    the target in H.1.3.1 after three rooms, as the mission's comment says."""
+    the target in H.1.1.6 after three rooms, as the mission's comment says."""
     mission = load_mission(Path(MISSIONS[0]).parent / "hospital_search.yaml")
     assert len(mission.searched_rooms()) == 18
     assert mission.world.interior is not None and mission.world.interior.group == "H"
     result = Simulation(mission).run()
     assert result.outcome == "found" and result.found_by == "ugv1"
-    assert result.target["room"] == "H.1.3.1" and len(result.rooms_searched) == 3
+    assert result.target["room"] == "H.1.1.6" and len(result.rooms_searched) == 3
     assert all(room.startswith("H.1.") for room in result.rooms_searched)

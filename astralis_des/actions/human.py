@@ -34,6 +34,8 @@ def inspect(ctx: Context, robot: Robot, task: Task) -> ActionGen:
     room = room_of(ctx, task)
     if room is None:
         return failed("inspect needs a room")
-    plane = cov.loop(room.box, InspectParams.model_validate(dict(task.params)).inset)
+    inset = InspectParams.model_validate(dict(task.params)).inset
+    plane = cov.loop(room.box, inset)
     plane = cov.start_near(plane, room.box, room.door_point("room"))  # type: ignore[arg-type]
+    plane = cov.within(plane, room.outline, inset)
     return (yield from search_path(ctx, robot, room, plane_to_floor(room, plane), "inspect"))

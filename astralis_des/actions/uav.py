@@ -53,6 +53,7 @@ def _pattern(name: str, inward: bool | None = None, axis: int | None = None):  #
             plane = cov.lawnmower(room.box, spacing, axis, margin=WALL_MARGIN)
         entry = room.door_point("room")
         plane = cov.start_near(plane, room.box, entry)  # type: ignore[arg-type]
+        plane = cov.within(plane, room.outline, WALL_MARGIN)
         return (yield from search_path(ctx, robot, room, plane_to_floor(room, plane), name))
 
     run.__name__ = name

@@ -153,7 +153,7 @@ class InBuilding(Strict):
         buildings = {world.segments[s].building for s in mission.searched_segments()}
         boxes = [r.box for r in world.rooms.values() if r.building in buildings]
         boxes += [s.box for s in world.spaces.values()
-                  if s.kind == "corridor" and s.building in buildings]
+                  if s.kind in ("corridor", "passage") and s.building in buildings]
         lo = np.array([b.lo for b in boxes]) + [self.margin, self.margin, 0.0]
         hi = np.array([b.hi for b in boxes]) - [self.margin, self.margin, 0.0]
         area = np.prod(np.maximum(hi - lo, 0.0)[:, :2], axis=1)
@@ -171,7 +171,13 @@ class Outdoor(Strict):
     def sampler(self, mission: Mission) -> Sampler:
         world = mission.world
         first = world.segments[mission.searched_segments()[0]].building
-        ex, ey, _ = world.buildings[first].entrance
+        if first not in world.entrances:
+            from astralis_des.errors import InputError
+
+            raise InputError(f"starts: outdoor starts are drawn round {first}'s entrance, and "
+                             f"{first} has none (an interior found no door to the outside)",
+                             key="starts")
+        ex, ey, _ = world.entrances[first]
         return _OutdoorStarts(mission, (ex, ey), self.radius)
 
 

@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from astralis_des.world.geometry import Box, FloatArray
+from astralis_des.world.geometry import Box, FloatArray, inside_polygon
+
+STEP = 0.25  # m: a pattern is cut to a room's outline at points this far apart
 
 
 def spiral(box: Box, spacing: float, inward: bool = True,
@@ -87,6 +89,32 @@ def start_near(path: FloatArray, box: Box, entry: FloatArray) -> FloatArray:
             if d < best_d - 1e-9:
                 best, best_d = candidate, d
     return best
+
+
+def within(path: FloatArray, outline: tuple[tuple[float, float], ...], margin: float
+           ) -> FloatArray:
+    """The part of ``path`` (drawn over a room's bounds) over the room's ``outline``, at least
+    ``margin`` from its edges across each axis: the path cut at points ``STEP`` apart, those
+    outside left out, and the corners and the ends of what is left kept. A room that is a
+    rectangle (no outline), or one that leaves less than a step of the path, keeps the path
+    as it is."""
+    if not outline or len(path) < 2:
+        return path
+    legs = np.diff(path, axis=0)
+    counts = np.maximum(np.ceil(np.linalg.norm(legs, axis=1) / STEP).astype(int), 1)
+    dense = np.vstack([path[k] + legs[k] * (np.arange(n) / n)[:, None]
+                       for k, n in enumerate(counts)] + [path[-1:]])
+    probes = dense[:, None, :] + np.array([[0, 0], [margin, 0], [-margin, 0], [0, margin],
+                                           [0, -margin]])
+    inside = inside_polygon(probes.reshape(-1, 2), np.asarray(outline)).reshape(-1, 5)
+    kept = dense[inside.all(axis=1)]
+    if len(kept) < 3 or np.ptp(kept, axis=0).max() < STEP:
+        return path  # too little of it over the room: the pattern as it was
+    turn = np.abs(np.cross(kept[1:-1] - kept[:-2], kept[2:] - kept[1:-1])) > 1e-9
+    jump = np.linalg.norm(np.diff(kept, axis=0), axis=1) > STEP * 1.01
+    keep = np.ones(len(kept), dtype=bool)
+    keep[1:-1] = turn | jump[:-1] | jump[1:]
+    return kept[keep]
 
 
 def _dedupe(points: FloatArray) -> FloatArray:

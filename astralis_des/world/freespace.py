@@ -21,7 +21,7 @@ from scipy import ndimage
 
 from astralis_des.errors import suggest
 from astralis_des.memo import kept
-from astralis_des.world.geometry import Box, FloatArray, boxes_array
+from astralis_des.world.geometry import Box, FloatArray, boxes_array, inside_polygon
 from astralis_des.world.model import BLOCK, World
 
 BoolArray = NDArray[np.bool_]
@@ -215,7 +215,7 @@ class FreeSpace:
     free: BoolArray  # floor, unoccupied, inside the room, connected to its centre
     boundary: BoolArray  # free cells along a wall (the traced boundary)
     open_floor: BoolArray  # floor and unoccupied anywhere on the grid (doorway, corridor)
-    inside: BoolArray  # cells whose centre is inside the room's box
+    inside: BoolArray  # cells whose centre is inside the room's box (and outline)
     door: BoolArray  # free cells opening onto the doorway
 
     @property
@@ -282,6 +282,8 @@ def _room_free_space(world: World, room_id: str, extra: Sequence[Box],
     centers = cell_centers(lo, shape, cell)
     inside = np.all((centers >= np.array(room.box.lo[:2])) &
                     (centers <= np.array(room.box.hi[:2])), axis=1).reshape(shape)
+    if room.outline:  # a room that is no rectangle: its outline, not its bounds
+        inside &= inside_polygon(centers, room.outline).reshape(shape)
     free = _component_at(open_floor & inside, centers, room.center[:2])
     beyond = open_floor & ~inside
     door = free & ndimage.binary_dilation(beyond, CROSS)

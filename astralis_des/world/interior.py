@@ -73,7 +73,8 @@ def interior_parts(spec: InteriorSpec, doc: LocatedYaml) -> tuple[
     (x0, y0), (x1, y1) = interior_bounds(spec)
     top = max(b.hi[2] for b in boxes.values())
     plan = InteriorPlan(spec.group, tuple(s.z for s in spec.storeys), tuple(openings),
-                        tuple(stairs), Box((x0, y0, spec.storeys[0].z), (x1, y1, top)), seats)
+                        tuple(stairs), Box((x0, y0, spec.storeys[0].z), (x1, y1, top)), seats,
+                        {p.id: tuple(p.outline) for p in spec.places})
     return rooms, {s: Segment(s, spec.group, int(s.split(".")[1]), tuple(ids))
                    for s, ids in segments.items()}, spaces, plan
 

@@ -5,6 +5,7 @@ A :class:`World` is immutable once built and may be shared by many simulations.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
@@ -29,6 +30,7 @@ if TYPE_CHECKING:
     from astralis_des.world.imported import Imported
 
 MAP_RESOLUTION = 0.2  # m, the planner's voxels in a world of boxes
+ENTRANCE_STEP = 1.5  # m outside an interior's entrance door: its entrance point
 __all__ = ["BLOCK", "MAP_RESOLUTION", "Building", "Door", "Room", "Segment", "Solid", "Space",
            "World"]
 
@@ -68,6 +70,21 @@ class World:
     def indoors(self) -> frozenset[str]:
         """The buildings' ids and the interior's group: the rooms of what has walls."""
         return frozenset([*self.buildings, *([self.interior.group] if self.interior else [])])
+
+    @cached_property
+    def entrances(self) -> dict[str, tuple[float, float, float]]:
+        """Just outside each building's (and the interior's first) entrance, at ground level:
+        where outdoor starts are drawn round and spots are listed from."""
+        out = {bid: b.entrance for bid, b in self.buildings.items()}
+        inner = self.interior
+        ways = [o for o in inner.openings if o.places[1] is None] if inner is not None else []
+        if inner is not None and ways:
+            door = ways[0].door
+            axis, seat = door.normal_axis, inner.seats[str(ways[0].places[0])]
+            point = list(door.center)
+            point[axis] -= math.copysign(ENTRANCE_STEP, seat[axis] - door.center[axis])
+            out[inner.group] = (point[0], point[1], point[2])
+        return out
 
     @cached_property
     def areas(self) -> list[Room]:

@@ -127,3 +127,4 @@ class InteriorPlan:
     stairs: tuple[Stair, ...]
     footprint: Box  # the bounds of its places, from the lowest floor to the top storey's top
     seats: dict[str, tuple[float, float, float]]  # every place's seat (floor height)
+    outlines: dict[str, tuple[tuple[float, float], ...]]  # every place's floor, xy

@@ -21,8 +21,14 @@ from scipy.sparse.csgraph import dijkstra
 
 from astralis_des.errors import InputError
 from astralis_des.kinds import KIND_DEFAULTS, KINDS, KindDefaults
-from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
-from astralis_des.world.parts import BLOCK, Building, InteriorPlan, Room, Solid, Space
+from astralis_des.world.geometry import (
+    FloatArray,
+    boxes_array,
+    inside_polygon,
+    segments_hit_boxes,
+)
+from astralis_des.world.interior_routes import reflex_corners, visible
+from astralis_des.world.parts import BLOCK, Building, Door, InteriorPlan, Room, Solid, Space
 
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
 STAIR_RUN_FACTOR = 2.0  # horizontal run of a flight of stairs per metre of rise
@@ -72,6 +78,7 @@ class Router:
         self.corridor_nodes: dict[str, list[int]] = {}
         self.outdoor_nodes: list[int] = []
         self.place_nodes: dict[str, list[int]] = {}  # an interior's places: their nodes
+        self._outlines: dict[str, FloatArray] = {}  # and their floors' outlines
         self._reach: dict[tuple[str, str, str], bool] = {}
         self._space_ids = list(world.spaces)
         self._space_boxes = boxes_array([s.box for s in world.spaces.values()])
@@ -223,13 +230,12 @@ class Router:
         for k, opening in enumerate(plan.openings):
             door = opening.door
             centre = self._node(f"{plan.group}:door{k}", door.center)
-            axis, at = door.normal_axis, door.center[door.normal_axis]
-            first = math.copysign(1.0, plan.seats[opening.places[0]][axis] - at)
-            for place in opening.places:  # the outside is across from the room
-                toward = first if place is None or place == opening.places[0] else \
-                    math.copysign(1.0, plan.seats[place][axis] - at)
+            axis = door.normal_axis
+            first = _into(plan, opening.places[0], door, DOORWAY + WALL_HALF)
+            for place in opening.places:  # the other place, or the outside, is across
+                toward = first if place == opening.places[0] else -first
                 point = list(door.center)
-                point[axis] += (toward if place is not None else -first) * (DOORWAY + WALL_HALF)
+                point[axis] += toward * (DOORWAY + WALL_HALF)
                 node = self._node(f"{plan.group}:door{k}:{place or 'outside'}",
                                   (point[0], point[1], point[2]))
                 self._edge(node, centre)
@@ -237,12 +243,19 @@ class Router:
                     self.outdoor_nodes.append(node)
                 else:
                     sides[place].append(node)
-        for place, doors in sides.items():
-            seat = self._node(place, plan.seats[place])
-            nodes = [seat, *doors]
-            for u, v in itertools.combinations(nodes, 2):
-                self._edge(u, v)
+        for place, doors in sides.items():  # a visibility graph in each place
+            outline = np.asarray(plan.outlines[place], dtype=float)
+            z = plan.seats[place][2]
+            corners = [self._node(f"{place}:corner{k}", (float(x), float(y), z))
+                       for k, (x, y) in enumerate(reflex_corners(outline))]
+            nodes = [self._node(place, plan.seats[place]), *doors, *corners]
+            pairs = np.array(list(itertools.combinations(range(len(nodes)), 2))).reshape(-1, 2)
+            xy = self.positions_of(nodes)
+            seen = visible(xy[pairs[:, 0]], xy[pairs[:, 1]], outline)
+            for i, j in pairs[seen]:
+                self._edge(nodes[i], nodes[j])
             self.place_nodes[place] = nodes
+            self._outlines[place] = outline
         for stair in plan.stairs:
             low, high = (self.index[p] for p in stair.places)
             rise = abs(self._pos[high][2] - self._pos[low][2])
@@ -309,9 +322,16 @@ class Router:
         best = int(np.argmin(d))  # the first of the nearest, as a scan in order would keep
         return self._snap_ids[best] if d[best] < SNAP else None
 
+    def positions_of(self, nodes: list[int]) -> FloatArray:
+        """``(N, 2)`` xy of ``nodes`` (while the graph is built too)."""
+        return np.array([self._pos[n][:2] for n in nodes], dtype=float).reshape(-1, 2)
+
     def _entries(self, p: FloatArray, place: str) -> list[int]:
-        if place in self.place_nodes:
-            return self.place_nodes[place]
+        if place in self.place_nodes:  # the nodes of an interior's place in sight of p
+            nodes = self.place_nodes[place]
+            xy = self.positions_of(nodes)
+            seen = visible(np.repeat(p[None, :2], len(nodes), 0), xy, self._outlines[place])
+            return [n for n, ok in zip(nodes, seen, strict=True) if ok] or nodes
         if place in self.world.rooms:
             return [self.index[place], self.index[f"{place}:inside"]]
         if place in self.corridor_nodes:
@@ -324,10 +344,10 @@ class Router:
             if b.lift is not None and on_lift in self.index and b.lift.contains(p):
                 return [self.index[on_lift], *stair]  # on the platform
             return stair
-        nodes = np.array(self.outdoor_nodes)
-        pts = self.positions[nodes]
+        outdoor = np.array(self.outdoor_nodes)
+        pts = self.positions[outdoor]
         clear = self._outdoor_clear(np.repeat(p[None, :], len(pts), 0), pts)
-        return [int(n) for n in nodes[clear]]
+        return [int(n) for n in outdoor[clear]]
 
     def reachable(self, start: FloatArray | tuple[float, ...], room_id: str, kind: str) -> bool:
         """Can a ``kind`` get from ``start`` to the room? It depends only on the place ``start``
@@ -354,7 +374,8 @@ class Router:
         q = np.asarray(goal, dtype=float)
         p_place, q_place = self.place_of(p), self.place_of(q)
         if p_place == q_place and (p_place != "outdoor" or self._outdoor_clear(
-                p[None, :], q[None, :])[0]):
+                p[None, :], q[None, :])[0]) and (p_place not in self._outlines or visible(
+                    p[None, :2], q[None, :2], self._outlines[p_place])[0]):
             return np.array([p, q])
         a = self._entries(p, p_place)
         b = self._entries(q, q_place)
@@ -371,6 +392,19 @@ class Router:
         while nodes[-1] != a[i]:
             nodes.append(int(pred[i][nodes[-1]]))
         return np.vstack([p, self.positions[nodes[::-1]], q])
+
+
+def _into(plan: InteriorPlan, place: str | None, door: Door, step: float) -> float:
+    """Which way along the door's axis (+1 or -1) ``place`` lies: where a point ``step``
+    through the door is inside its outline, else towards its seat."""
+    assert place is not None  # a door's first place is a place; only the second may be out
+    axis, outline = door.normal_axis, np.asarray(plan.outlines[place], dtype=float)
+    for sign in (1.0, -1.0):
+        probe = np.array(door.center[:2], dtype=float)
+        probe[axis] += sign * step
+        if inside_polygon(probe[None, :], outline)[0]:
+            return sign
+    return math.copysign(1.0, plan.seats[place][axis] - door.center[axis])
 
 
 def _by_stairs(kind: KindDefaults, building: Building) -> bool:

@@ -131,7 +131,7 @@ class Scene:
             if not self.enabled:
                 self.set_clutter(room_id, Clutter((), ()))
             else:
-                indoors = self.world.rooms[room_id].building in self.world.buildings
+                indoors = self.world.rooms[room_id].building in self.world.indoors
                 placed = furnish(self.world, room_id, self.messiness.get(room_id, 0.0),
                                  self.seed, self._order[room_id],
                                  self.catalogue if indoors else self.outdoors)
@@ -249,7 +249,7 @@ class Scene:
     def _patrol(self, ident: str, room_id: str, where: tuple[float, ...],
                 size: tuple[float, float, float], attributes: tuple[tuple[str, Any], ...]) -> Mover:
         room = self.world.rooms[room_id]
-        ring = cov.loop(room.box, PATROL_INSET)
+        ring = cov.within(cov.loop(room.box, PATROL_INSET), room.outline, PATROL_INSET)
         loop = np.column_stack([ring, np.full(len(ring), where[2])])
         mover = Mover(ident, "avatar", loop, 1.0, size, attributes=attributes)
         nearest = int(np.argmin(np.linalg.norm(loop[:, :2] - np.array(where[:2]), axis=1)))

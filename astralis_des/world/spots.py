@@ -39,8 +39,8 @@ class Spot:
 def reference(world: World) -> tuple[float, float]:
     """Where spots are nearest to unless told: the first building's entrance (where a study
     draws outdoor starts), else the middle of the site."""
-    if world.buildings:
-        x, y, _ = world.buildings[min(world.buildings)].entrance
+    if world.entrances:
+        x, y, _ = world.entrances[min(world.entrances)]
         return (float(x), float(y))
     return (world.site[0] / 2, world.site[1] / 2)
 
