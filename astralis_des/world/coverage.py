@@ -104,8 +104,9 @@ def within(path: FloatArray, outline: tuple[tuple[float, float], ...], margin: f
     counts = np.maximum(np.ceil(np.linalg.norm(legs, axis=1) / STEP).astype(int), 1)
     dense = np.vstack([path[k] + legs[k] * (np.arange(n) / n)[:, None]
                        for k, n in enumerate(counts)] + [path[-1:]])
-    probes = dense[:, None, :] + np.array([[0, 0], [margin, 0], [-margin, 0], [0, margin],
-                                           [0, -margin]])
+    reach = margin * 0.98  # a pattern inset by ``margin`` from a side lies on it, not outside
+    probes = dense[:, None, :] + np.array([[0, 0], [reach, 0], [-reach, 0], [0, reach],
+                                           [0, -reach]])
     inside = inside_polygon(probes.reshape(-1, 2), np.asarray(outline)).reshape(-1, 5)
     kept = dense[inside.all(axis=1)]
     if len(kept) < 3 or np.ptp(kept, axis=0).max() < STEP:
