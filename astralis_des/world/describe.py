@@ -39,6 +39,11 @@ def headline(world: World) -> str:
         n = sum(1 for r in world.rooms.values() if r.building == bid)
         lift = ", a vehicle lift" if b.lift is not None else ""
         parts.append(f"{bid}: {b.floors} storeys of {b.floor_height:g} m, {n} rooms{lift}")
+    inner = world.interior
+    if inner is not None:
+        n = sum(1 for r in world.rooms.values() if r.building == inner.group)
+        parts.append(f"{inner.group}: found in a scan or model, {len(inner.storeys)} storeys, "
+                     f"{n} rooms, {len(inner.openings)} doors, {len(inner.stairs)} stairs")
     return (f"world {world.name}: site {world.site[0]:g} x {world.site[1]:g} m; "
             f"{len(world.segments)} segments, {len(world.rooms)} rooms"
             + ("; " + "; ".join(parts) if parts else ""))

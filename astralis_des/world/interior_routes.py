@@ -7,10 +7,13 @@ a rectangle every two see each other, as in a built-in room or corridor.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
 from astralis_des.world.geometry import FloatArray, inside_polygon
+from astralis_des.world.parts import Door, InteriorPlan
 
 CORNER = 0.8  # m from a reflex corner, inwards, where a route turns round it: clear of both
 # walls by a UGV's half width and its rim
@@ -49,6 +52,19 @@ def visible(a: FloatArray, b: FloatArray, outline: FloatArray) -> NDArray[np.boo
     d4 = _side(e0[None], e1[None], b[:, None]) if len(b) else np.zeros((0, len(e0)))
     crosses = ((d1 * d2) < 0) & ((d3 * d4) < 0)
     return np.asarray(~crosses.any(axis=1) & inside_polygon((a + b) / 2, e0))
+
+
+def side_of(plan: InteriorPlan, place: str | None, door: Door, step: float) -> float:
+    """Which way along the door's axis (+1 or -1) ``place`` lies: where a point ``step``
+    through the door is inside its outline, else towards its seat."""
+    assert place is not None  # a door's first place is a place; only the second may be out
+    axis, outline = door.normal_axis, np.asarray(plan.outlines[place], dtype=float)
+    for sign in (1.0, -1.0):
+        probe = np.array(door.center[:2], dtype=float)
+        probe[axis] += sign * step
+        if inside_polygon(probe[None, :], outline)[0]:
+            return sign
+    return math.copysign(1.0, plan.seats[place][axis] - door.center[axis])
 
 
 def _side(a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:

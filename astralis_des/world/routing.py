@@ -21,14 +21,9 @@ from scipy.sparse.csgraph import dijkstra
 
 from astralis_des.errors import InputError
 from astralis_des.kinds import KIND_DEFAULTS, KINDS, KindDefaults
-from astralis_des.world.geometry import (
-    FloatArray,
-    boxes_array,
-    inside_polygon,
-    segments_hit_boxes,
-)
-from astralis_des.world.interior_routes import reflex_corners, visible
-from astralis_des.world.parts import BLOCK, Building, Door, InteriorPlan, Room, Solid, Space
+from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
+from astralis_des.world.interior_routes import reflex_corners, side_of, visible
+from astralis_des.world.parts import BLOCK, Building, InteriorPlan, Room, Solid, Space
 
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
 STAIR_RUN_FACTOR = 2.0  # horizontal run of a flight of stairs per metre of rise
@@ -231,7 +226,7 @@ class Router:
             door = opening.door
             centre = self._node(f"{plan.group}:door{k}", door.center)
             axis = door.normal_axis
-            first = _into(plan, opening.places[0], door, DOORWAY + WALL_HALF)
+            first = side_of(plan, opening.places[0], door, DOORWAY + WALL_HALF)
             for place in opening.places:  # the other place, or the outside, is across
                 toward = first if place == opening.places[0] else -first
                 point = list(door.center)
@@ -392,19 +387,6 @@ class Router:
         while nodes[-1] != a[i]:
             nodes.append(int(pred[i][nodes[-1]]))
         return np.vstack([p, self.positions[nodes[::-1]], q])
-
-
-def _into(plan: InteriorPlan, place: str | None, door: Door, step: float) -> float:
-    """Which way along the door's axis (+1 or -1) ``place`` lies: where a point ``step``
-    through the door is inside its outline, else towards its seat."""
-    assert place is not None  # a door's first place is a place; only the second may be out
-    axis, outline = door.normal_axis, np.asarray(plan.outlines[place], dtype=float)
-    for sign in (1.0, -1.0):
-        probe = np.array(door.center[:2], dtype=float)
-        probe[axis] += sign * step
-        if inside_polygon(probe[None, :], outline)[0]:
-            return sign
-    return math.copysign(1.0, plan.seats[place][axis] - door.center[axis])
 
 
 def _by_stairs(kind: KindDefaults, building: Building) -> bool:
