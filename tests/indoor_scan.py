@@ -38,8 +38,8 @@ if TYPE_CHECKING:
     import trimesh
 
 FLIGHT = 1.3  # m over each floor
-STEP = 1.75  # m, the most between stops along a lane or a climb
-LANE = 3.0  # m, the most between lanes
+STEP = 2.5  # m, the most between stops along a lane or a climb
+LANE = 4.0  # m, the most between lanes
 MARGIN = 0.5  # m kept from a room's walls
 NEAR = 0.3  # m: a door this near a room's floor rectangle opens into it
 VOXEL = 0.04  # m, the cloud's thinning cube

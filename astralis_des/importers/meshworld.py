@@ -65,18 +65,19 @@ def mesh_world(mesh: Mesh, path: Path, opts: ImportOptions) -> Built:
     upright = to_z_up(np.where(good[:, None], mesh.vertices, 0.0), up) * scale
     used = np.unique(faces)
     heading, pivot = 0.0, upright[used].mean(axis=0)
-    if opts.indoor:  # turned so that the walls run along x and y
-        heading = indoor_heading(surface_points(upright, faces, INDOOR_SPACING, seed=opts.seed),
-                                 path)
-        upright = turn_about(upright, -heading, pivot) if heading else upright
+    points = np.zeros((0, 3))
+    if opts.indoor:  # its surfaces as a cloud, turned so that the walls run along x and y
+        points = surface_points(upright, faces, INDOOR_SPACING, seed=opts.seed)
+        heading = indoor_heading(points, path)
+        if heading:
+            upright, points = (turn_about(a, -heading, pivot) for a in (upright, points))
     origin = upright[used].min(axis=0) - np.array([opts.margin, opts.margin, 0.0])
     vertices = upright - origin
     notes: list[str] = []
     interior = None
     if opts.indoor:  # storeys, rooms and doors, the lowest floor brought to z = 0
-        points = surface_points(vertices, faces, INDOOR_SPACING, seed=opts.seed)
-        interior, floor = indoor_section(points, opts.group, path, notes, opts.door_max,
-                                         heading)
+        interior, floor = indoor_section(points - origin, opts.group, path, notes,
+                                         opts.door_max, heading)
         origin[2] += floor
         vertices[:, 2] -= floor
     tri = triangles(vertices, faces)
