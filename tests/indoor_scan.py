@@ -11,12 +11,13 @@ storey where a shaft is clear all the way up (building A's stairwell), or starts
 (carried up a stair the scene does not model: the irregular building has none).
 
 :func:`lidar_scan` sweeps the lidar of :mod:`astralis_des.physics.lidar3d` at every stop (its
-channels, vertical field, resolution, range and range noise; its slab test over the scene's
-boxes, furniture included, which is 5 times faster than Bullet's ``rayTestBatch`` here). A
-level 16-channel unit sees no floor nearer than 4.9 m from 1.3 m up (its beams reach 15°
-down), nothing of a small room's floor: like a mapping drone's rotating mount, each stop
+channels, vertical field, range and range noise, at ``RESOLUTION``; its slab test over the
+scene's boxes, furniture included, which is 5 times faster than Bullet's ``rayTestBatch``
+here). A level 16-channel unit sees no floor nearer than 4.9 m from 1.3 m up (its beams reach
+15° down), nothing of a small room's floor: like a mapping drone's rotating mount, each stop
 sweeps with the spin axis upright, then along x, then along y (an axis permutation keeps the
 boxes axis-aligned for the slab test). Points are thinned to one per ``VOXEL`` cube.
+
 :func:`write_cloud` writes a cloud as PLY or LAS/LAZ; :func:`scene_mesh` makes the scene's
 boxes one mesh, and :func:`write_mesh` writes it (GLB Y-up, as glTF says).
 """
@@ -43,6 +44,7 @@ LANE = 4.0  # m, the most between lanes
 MARGIN = 0.5  # m kept from a room's walls
 NEAR = 0.3  # m: a door this near a room's floor rectangle opens into it
 VOXEL = 0.04  # m, the cloud's thinning cube
+RESOLUTION = 0.4  # degrees between a channel's beams: a VLP-16 spinning at 20 Hz
 SPINS = ((0, 1, 2), (1, 2, 0), (2, 0, 1))  # the world axes along the sensor's x, y, z:
 # the spin axis is z (level), then x, then y
 THIN_EVERY = 24  # stops between thinnings, keeping memory to a few sweeps' worth
@@ -207,7 +209,8 @@ def lidar_scan(scene: Scene, seed: int = 0, voxel: float = VOXEL) -> np.ndarray:
     """``(N, 3)`` points of the lidar's sweeps at every stop of :func:`flight`, range noise
     drawn with ``seed``, thinned to one per ``voxel`` cube."""
     rng = np.random.default_rng(seed)
-    lidar = Lidar3D(None, NO_BODY, rng=rng)  # type: ignore[arg-type]  # its beams, no client
+    lidar = Lidar3D(None, NO_BODY, rng=rng,  # type: ignore[arg-type]  # its beams, no client
+                    resolution=RESOLUTION)
     solids = np.array(scene.solids, dtype=float)
     kept: list[np.ndarray] = []
     for n, stop in enumerate(flight(scene), start=1):
