@@ -45,7 +45,7 @@ class Twin:
 
 def twin_section(found: Interior, group: str, storey_z: list[float]) -> Twin:
     """The section for ``found`` (in world coordinates), its storeys' floors at ``storey_z``
-    (the floors' blocks' tops, which robots stand on)."""
+    (the world's heights of the floors found)."""
     notes: list[str] = []
     stairwells, stairs = _shafts(found)
     length = robot()[1]
