@@ -63,7 +63,7 @@ def place_of(world: World, box: Box) -> str:
         if lo[0] - 0.5 <= centre[0] <= hi[0] + 0.5 and lo[1] - 0.5 <= centre[1] <= hi[1] + 0.5:
             storey = math.floor((centre[2] + 0.3) / b.floor_height) + 1
             return f"{bid}/roof" if storey > b.floors else f"{bid}/{max(storey, 1)}"
-    return interior_places(world, np.array([centre]))[0]
+    return "site" if world.interior is None else interior_places(world, np.array([centre]))[0]
 
 
 def interior_places(world: World, centres: np.ndarray) -> list[str]:

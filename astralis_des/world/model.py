@@ -5,7 +5,6 @@ A :class:`World` is immutable once built and may be shared by many simulations.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
@@ -14,6 +13,7 @@ import numpy as np
 
 from astralis_des.memo import kept
 from astralis_des.world.geometry import FloatArray, boxes_array, inside_polygon
+from astralis_des.world.interior_routes import side_of
 from astralis_des.world.parts import (
     BLOCK,
     Building,
@@ -80,9 +80,9 @@ class World:
         ways = [o for o in inner.openings if o.places[1] is None] if inner is not None else []
         if inner is not None and ways:
             door = ways[0].door
-            axis, seat = door.normal_axis, inner.seats[str(ways[0].places[0])]
             point = list(door.center)
-            point[axis] -= math.copysign(ENTRANCE_STEP, seat[axis] - door.center[axis])
+            point[door.normal_axis] -= side_of(inner, ways[0].places[0], door, ENTRANCE_STEP) \
+                * ENTRANCE_STEP  # across from the place inside
             out[inner.group] = (point[0], point[1], point[2])
         return out
 
