@@ -45,7 +45,7 @@ from astralis_des.importers.indoor_world import (
 )
 from astralis_des.importers.options import Built, ImportOptions
 from astralis_des.importers.source import Cloud
-from astralis_des.importers.survey import Survey, sample, survey, turn_about, turned
+from astralis_des.importers.survey import Survey, sample, survey, turn_about, turned_survey
 from astralis_des.importers.voxels import MAX_INDEX, cells_across
 
 log = logging.getLogger(__name__)
@@ -62,7 +62,7 @@ def cloud_world(cloud: Cloud, path: Path, opts: ImportOptions, fmt: str) -> Buil
     notes = [*cloud.notes, f"units: {found.metres.frame.note}", *found.notes]
     heading = indoor_heading(sample(found, HEADING_SAMPLE), path) if opts.indoor else 0.0
     if heading:  # an indoor scan is turned so that its walls run along x and y
-        found = turned(found, -heading)
+        found = turned_survey(found, -heading)
     voxel = _voxel(found, opts, path, notes)
     rng = np.random.default_rng(opts.seed)
     ground = _ground(cloud, found, opts, path, rng)

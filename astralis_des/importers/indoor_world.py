@@ -21,6 +21,8 @@ from astralis_des.world.spec import InteriorSpec
 
 log = logging.getLogger(__name__)
 TURN = 0.2  # degrees: a scan whose walls run further off its axes is turned along them
+NO_STOREY = ("--indoor: no storey found (no floor under a ceiling with walls between): is this "
+             "an indoor scan?")
 HEADING_SAMPLE = 1_000_000  # points the walls' heading is found from
 
 
@@ -34,8 +36,7 @@ def indoor_heading(points: np.ndarray, path: Path) -> float:
     except ValueError as exc:
         raise InputError(f"--indoor: {exc}", file=path) from None
     if not storeys:
-        raise InputError("--indoor: no storey found (no floor under a ceiling with walls "
-                         "between): is this an indoor scan?", file=path)
+        raise InputError(NO_STOREY, file=path)
     heading = walls_heading(pts, storeys)
     return heading if abs(math.degrees(heading)) > TURN else 0.0
 
@@ -52,11 +53,10 @@ def indoor_section(points: np.ndarray, group: str, path: Path, notes: list[str],
     except ValueError as exc:
         raise InputError(f"--indoor: {exc}", file=path) from None
     if not found.storeys:
-        raise InputError("--indoor: no storey found (no floor under a ceiling with walls "
-                         "between): is this an indoor scan?", file=path)
+        raise InputError(NO_STOREY, file=path)
     lowest = found.storeys[0].z
-    twin = twin_section(found, group, [round(s.z - lowest, 2) for s in found.storeys])
-    twin.section["heading"] = round(math.degrees(heading), 2)
+    twin = twin_section(found, group, [round(s.z - lowest, 2) for s in found.storeys],
+                        round(math.degrees(heading), 2))
     notes.extend(twin.notes)
     places: list[dict[str, Any]] = twin.section["places"]  # type: ignore[assignment]
     rooms = [p for p in places if p["kind"] in ("room", "hall")]

@@ -18,6 +18,7 @@ from astralis_des.errors import InputError
 from astralis_des.importers.crs import Frame, frame_for
 from astralis_des.importers.density import GAP_XY, GAP_Z, SAMPLE, Strays, spacing
 from astralis_des.importers.ground import GROUND_CLASS
+from astralis_des.importers.indoor.heading import turned
 from astralis_des.importers.source import Cloud
 from astralis_des.world.geometry import FloatArray
 
@@ -133,16 +134,13 @@ def survey(cloud: Cloud, units: str, crs: str | None, scale: float,
 
 def turn_about(points: FloatArray, angle: float, pivot: FloatArray) -> FloatArray:
     """``(N, 3)`` points turned by ``angle`` radians (anticlockwise) about the vertical line
-    through ``pivot`` (xy)."""
-    c, s = np.cos(angle), np.sin(angle)
-    x, y = points[:, 0] - pivot[0], points[:, 1] - pivot[1]
-    out = np.array(points, dtype=np.float64)
-    out[:, 0] = pivot[0] + x * c - y * s
-    out[:, 1] = pivot[1] + x * s + y * c
-    return out
+    through ``pivot`` (xy): :func:`.indoor.heading.turned` about it."""
+    shift = np.zeros(points.shape[1])
+    shift[:2] = np.asarray(pivot, dtype=np.float64)[:2]
+    return np.asarray(turned(np.asarray(points, dtype=np.float64) - shift, angle) + shift)
 
 
-def turned(found: Survey, angle: float) -> Survey:
+def turned_survey(found: Survey, angle: float) -> Survey:
     """``found`` with its points turned by ``angle`` radians about the middle of their
     bounds: the bounds found anew (the spacing, the strays and the classes are the same)."""
     pivot = (found.lo[:2] + found.hi[:2]) / 2

@@ -43,9 +43,11 @@ class Twin:
     notes: tuple[str, ...]
 
 
-def twin_section(found: Interior, group: str, storey_z: list[float]) -> Twin:
+def twin_section(found: Interior, group: str, storey_z: list[float],
+                 heading: float = 0.0) -> Twin:
     """The section for ``found`` (in world coordinates), its storeys' floors at ``storey_z``
-    (the world's heights of the floors found)."""
+    (the world's heights of the floors found), the scan turned by minus ``heading`` degrees
+    to get there."""
     notes: list[str] = []
     stairwells, stairs = _shafts(found)
     length = robot()[1]
@@ -69,7 +71,7 @@ def twin_section(found: Interior, group: str, storey_z: list[float]) -> Twin:
               for r, k in sorted(kept, key=lambda rk: _order(ids[rk[0].id]))]
     section: dict[str, object] = {
         "group": group,
-        "heading": round(float(np.degrees(found.heading)), 3),
+        "heading": heading,
         "storeys": [{"level": s.index, "z": round(z, 3), "height": round(s.height, 3)}
                     for s, z in zip(found.storeys, storey_z, strict=True)],
         "places": places,
