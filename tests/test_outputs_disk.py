@@ -205,6 +205,24 @@ def test_a_recording_that_does_not_read_back_is_an_error(tmp_path: Path) -> None
         check_recording(cut)
 
 
+@pytest.mark.parametrize("keep", [0, 4, 12, 20, 400, -40, -32, -1, 1])
+def test_a_recording_cut_anywhere_does_not_read_back(tmp_path: Path, keep: int) -> None:
+    """Its framing is read back: the header, each message's length up to the end message,
+    and the footer that points at the manifest. A file cut at any byte (or with a byte too
+    many, ``keep`` 1) is refused, naming why."""
+    from astralis_des import Simulation, load_mission
+    from astralis_des.sinks.rrd_check import broken, check_recording
+
+    Simulation(load_mission(MISSION), out_dir=tmp_path / "run").run()
+    whole = (tmp_path / "run" / "recording.rrd").read_bytes()
+    cut = tmp_path / "cut.rrd"
+    cut.write_bytes(whole + b"\0" if keep == 1 else whole[:keep] if keep else b"")
+    assert broken(cut) is not None
+    with pytest.raises(OSError, match=r"does not read back \((no |cut short|a message|its "
+                                      r"footer|bytes after)"):
+        check_recording(cut)
+
+
 def test_a_nan_never_reaches_a_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """JSON is written strict: a NaN in a summary is an error naming where it is, and the
     run's folder is not put in place."""

@@ -108,6 +108,35 @@ def test_the_recording_loads_with_its_entity_tree(faults_run: tuple[RunResult, P
             assert f"/robots/{rid}/{leaf}" in rows, (rid, leaf)
 
 
+def test_a_mission_run_again_in_one_process_records_the_same(tmp_path: Path) -> None:
+    """The world's solids and the robots' looks are sent as chunks prepared by the first run,
+    and the layout as the bytes kept from the second: the third recording holds the same
+    rows, the same views and its blueprint made active, and reads back whole."""
+    from astralis_des.sinks import blueprint, prepared
+    from astralis_des.sinks.rrd_check import FILE_MAGIC, HEADER, MESSAGE
+
+    prepared._PREPARED.clear()
+    blueprint._SEEN.clear()
+    mission = load_mission(ROOT / "missions" / "faults.yaml")
+    rrds = []
+    for n in range(3):
+        Simulation(mission, out_dir=tmp_path / str(n)).run()
+        rrds.append(tmp_path / str(n) / "recording.rrd")
+    verify(rrds[2])
+    assert chunks(rrds[2]) == chunks(rrds[0])
+    views = [sorted(json.dumps(view, sort_keys=True, default=str) for view in
+                     layout(rrd)[0].values()) for rrd in rrds]
+    assert views[2] == views[1] == views[0] and len(views[0]) >= 8
+    data = rrds[2].read_bytes()
+    assert data.startswith(FILE_MAGIC)
+    at, kinds = HEADER, []
+    while not kinds or kinds[-1] != 0:
+        kind, length = MESSAGE.unpack_from(data, at)
+        kinds.append(kind)
+        at += MESSAGE.size + length
+    assert kinds.count(3) == 1  # the blueprint's activation
+
+
 def test_one_state_change_per_task_start_and_end(faults_run: tuple[RunResult, Path]) -> None:
     """Each lane starts idle, then changes at every task start and end, fault and recovery."""
     result, rrd = faults_run

@@ -4,6 +4,7 @@ trails, each robot's task and the events as text, on one ``sim_time`` timeline."
 from __future__ import annotations
 
 from collections.abc import Generator, Mapping, Sequence
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -12,7 +13,7 @@ import numpy as np
 from astralis_des.kernel.catalogue import level_of
 from astralis_des.kernel.events import Record
 from astralis_des.sinks import paths
-from astralis_des.sinks.blueprint import Layout, blueprint
+from astralis_des.sinks.blueprint import APPLICATION, Layout, send_layout
 from astralis_des.sinks.looks import (
     ROAD_COLOR,
     by_height,
@@ -22,6 +23,7 @@ from astralis_des.sinks.looks import (
     robot_colors,
     solid_color,
 )
+from astralis_des.sinks.prepared import send_prepared
 from astralis_des.sinks.replay import log_lanes, log_metrics, metrics, task_lanes
 from astralis_des.sinks.rounds import GRAPH_AGENTS, Grid, log_rounds
 from astralis_des.sinks.rrd_check import close_and_check
@@ -62,7 +64,8 @@ class RerunRecorder:
         self.rr = rr
         self.sim = sim
         spec = sim.mission.spec
-        self.rec = rr.RecordingStream("astralis_des", recording_id=f"{spec.name}-{spec.seed}")
+        self.recording_id = f"{spec.name}-{spec.seed}"
+        self.rec = rr.RecordingStream(APPLICATION, recording_id=self.recording_id)
         self.rec.set_log_time_enabled(False)  # one timeline: simulated time
         self.path = path
         self.rec.save(path)
@@ -88,7 +91,8 @@ class RerunRecorder:
 
     def _log_world(self) -> None:
         rr, rec, sim = self.rr, self.rec, self.sim
-        log_solids(rr, rec, sim.world)
+        world = sim.world
+        send_prepared(rr, rec, ("solids", id(world)), world, lambda s: log_solids(rr, s, world))
         target = sim.target
         rec.log(paths.WORLD_TARGET, rr.Points3D([target.position], radii=0.3,
                                                 colors=[(255, 0, 255)],
@@ -151,16 +155,14 @@ class RerunRecorder:
             pts = np.array(robot.trail_p, dtype=float)
             color = palette[rid]
             log_body(rr, rec, robot, color)
-            rec.log(paths.robot_pose(rid), rr.Points3D.from_fields(
-                radii=0.35, colors=[color], labels=[rid]), static=True)
+            send_prepared(rr, rec, ("robot", rid, color, bool(robot.plans)), None,
+                          partial(log_robot_looks, rr, rid, color, bool(robot.plans)))
             rec.log(paths.robot_trail(rid), rr.LineStrips3D([pts], colors=[color], radii=0.05),
                     static=True)
             if robot.plans:  # each leg's planned path, from when it was set out on
                 rec.send_columns(paths.robot_plan(rid), indexes=[rr.TimeColumn(
                     paths.TIMELINE, duration=[t for t, _ in robot.plans])],
                     columns=rr.LineStrips3D.columns(strips=[p for _, p in robot.plans]))
-                rec.log(paths.robot_plan(rid), rr.LineStrips3D.from_fields(
-                    colors=[(*color[:3], 140)], radii=0.03), static=True)
         self._log_replay(result, perception)
         close_and_check(rec, self.path)  # Rerun's file sink only logs a failed write
 
@@ -209,11 +211,21 @@ class RerunRecorder:
                   max(b.hi[2] for b in rooms)))
         shown = [sim.world.rooms[result.target["room"]]] if result.found_by else \
             [min(searched, key=lambda r: r.floor)]  # up to where it was found, or began
-        rec.send_blueprint(blueprint(Layout(
+        send_layout(rec, self.recording_id, Layout(
             team=kinds, focus=focus, end=result.end_time, finder=result.found_by,
             cameras=cameras, hidden=above(sim.world, shown),
             sensed=sorted({rid for rid, _ in sim.pose_sensors.sensors}), graph=graph,
-            matrix=Grid.largest(sim.rounds).bounds())))
+            matrix=Grid.largest(sim.rounds).bounds()))
+
+
+def log_robot_looks(rr: Any, rid: str, color: tuple[int, int, int, int], planned: bool,
+                    rec: Any) -> None:
+    """A robot's static looks: its pose's dot and label, its plans' colour."""
+    rec.log(paths.robot_pose(rid), rr.Points3D.from_fields(radii=0.35, colors=[color],
+                                                           labels=[rid]), static=True)
+    if planned:
+        rec.log(paths.robot_plan(rid), rr.LineStrips3D.from_fields(
+            colors=[(*color[:3], 140)], radii=0.03), static=True)
 
 
 def above(world: World, shown: Sequence[Any]) -> list[str]:

@@ -1,0 +1,62 @@
+"""Static parts of a recording that are the same from run to run (a world's walls, slabs and
+imported mesh or cloud, a robot's body), logged once per process and sent to each later
+recording as prepared chunks.
+
+Each ``log`` call of Rerun's Python SDK converts its archetype anew, about 0.1 to 0.5 ms; a
+prepared chunk is sent as it is (the default world's solids: 2.4 ms logged, 0.2 ms sent).
+They are prepared by logging into a throwaway recording saved to a temporary file and read
+back; where that fails (no temporary folder), they are logged as before."""
+
+from __future__ import annotations
+
+import logging
+import tempfile
+from collections import OrderedDict
+from collections.abc import Callable, Hashable
+from pathlib import Path
+from typing import Any
+
+from astralis_des.sinks.blueprint import APPLICATION
+
+log = logging.getLogger(__name__)
+
+KEPT = 32  # prepared parts a process keeps (the least recently sent go first)
+_PREPARED: OrderedDict[Hashable, tuple[Any, list[Any]]] = OrderedDict()
+
+
+def send_prepared(rr: Any, rec: Any, key: Hashable, owner: Any,
+                  logged: Callable[[Any], None]) -> None:
+    """Send to ``rec`` what ``logged(stream)`` logs (static only), prepared the first time a
+    process sees ``key`` for ``owner`` (the object it is made of, if any: a world, a kind's
+    record; kept with it, so that ``key`` may hold its ``id``)."""
+    kept = _PREPARED.pop(key, None)
+    chunks = kept[1] if kept is not None and kept[0] is owner else _prepare(rr, logged)
+    if chunks is None:
+        logged(rec)
+        return
+    _PREPARED[key] = (owner, chunks)
+    while len(_PREPARED) > KEPT:
+        _PREPARED.popitem(last=False)
+    rec.send_chunks(chunks)
+
+
+def _prepare(rr: Any, logged: Callable[[Any], None]) -> list[Any] | None:
+    """The chunks ``logged`` makes, read back from a throwaway recording (``None`` if it
+    could not be written)."""
+    from rerun.chunk import RrdReader
+
+    try:
+        with tempfile.TemporaryDirectory(prefix="astralis-prepared-") as folder:
+            path = Path(folder) / "prepared.rrd"
+            stream = rr.RecordingStream(APPLICATION, recording_id="prepared",
+                                        send_properties=False)
+            stream.set_log_time_enabled(False)
+            stream.save(path)
+            logged(stream)
+            stream.flush()
+            stream.disconnect()
+            return [chunk for chunk in RrdReader(path).stream().to_chunks()
+                    if not chunk.entity_path.startswith("/__")]
+    except (OSError, RuntimeError) as exc:  # no temporary folder to write it to
+        log.debug("not prepared (%s): logged as it is", exc)
+        return None
