@@ -109,8 +109,8 @@ def test_the_recording_loads_with_its_entity_tree(faults_run: tuple[RunResult, P
 
 
 def test_a_mission_run_again_in_one_process_records_the_same(tmp_path: Path) -> None:
-    """The world's solids and the robots' looks are sent as chunks prepared by the first run,
-    and the layout as the bytes kept from the second: the third recording holds the same
+    """The second run of a mission in a process prepares the world's solids as chunks and
+    keeps its layout encoded; the third sends both as they are. Its recording holds the same
     rows, the same views and its blueprint made active, and reads back whole."""
     from astralis_des.sinks import blueprint, prepared
     from astralis_des.sinks.rrd_check import FILE_MAGIC, HEADER, MESSAGE

@@ -15,7 +15,6 @@ from astralis_des.kernel.robot import Robot
 from astralis_des.kinds import KIND_DEFAULTS, KindDefaults
 from astralis_des.registry import Registry
 from astralis_des.sinks import paths
-from astralis_des.sinks.prepared import send_prepared
 from astralis_des.world.clutter import Placed
 from astralis_des.world.geometry import Box
 from astralis_des.world.model import World
@@ -120,9 +119,7 @@ def log_body(rr: Any, rec: Any, robot: Robot, color: tuple[int, int, int, int]) 
         robot.trail_t, dtype=float))], columns=rr.Transform3D.columns(translation=pts,
                                                                        quaternion=quats))
     kind = KIND_DEFAULTS[robot.kind]
-    draw = LOOKS.get(kind.look)
-    send_prepared(rr, rec, ("body", entity, robot.kind, color), kind,
-                  lambda stream: draw(rr, stream, entity, color, kind))
+    LOOKS.get(kind.look)(rr, rec, entity, color, kind)
 
 
 Color = tuple[int, int, int, int]

@@ -1,6 +1,6 @@
 """Static parts of a recording that are the same from run to run (a world's walls, slabs and
-imported mesh or cloud, a robot's body), logged once per process and sent to each later
-recording as prepared chunks.
+imported blocks, mesh or cloud), prepared once per process and sent to each later recording
+as chunks.
 
 Each ``log`` call of Rerun's Python SDK converts its archetype anew, about 0.1 to 0.5 ms; a
 prepared chunk is sent as it is (the default world's solids: 2.4 ms logged, 0.2 ms sent).
@@ -21,23 +21,28 @@ from astralis_des.sinks.blueprint import APPLICATION
 log = logging.getLogger(__name__)
 
 KEPT = 32  # prepared parts a process keeps (the least recently sent go first)
-_PREPARED: OrderedDict[Hashable, tuple[Any, list[Any]]] = OrderedDict()
+_PREPARED: OrderedDict[Hashable, tuple[Any, list[Any] | None]] = OrderedDict()
 
 
 def send_prepared(rr: Any, rec: Any, key: Hashable, owner: Any,
                   logged: Callable[[Any], None]) -> None:
-    """Send to ``rec`` what ``logged(stream)`` logs (static only), prepared the first time a
-    process sees ``key`` for ``owner`` (the object it is made of, if any: a world, a kind's
-    record; kept with it, so that ``key`` may hold its ``id``)."""
+    """Send to ``rec`` what ``logged(stream)`` logs (static only). The first time a process
+    sees ``key`` for ``owner`` (the object it is made of, kept with it so that ``key`` may
+    hold its ``id``), it is logged as it is; the second time it is prepared (a throwaway
+    recording costs a few ms, not worth it for a one-off run) and sent as chunks from then
+    on."""
     kept = _PREPARED.pop(key, None)
-    chunks = kept[1] if kept is not None and kept[0] is owner else _prepare(rr, logged)
-    if chunks is None:
-        logged(rec)
-        return
+    seen = kept is not None and kept[0] is owner
+    chunks = kept[1] if kept is not None and seen else None
+    if seen and chunks is None:
+        chunks = _prepare(rr, logged)
     _PREPARED[key] = (owner, chunks)
     while len(_PREPARED) > KEPT:
         _PREPARED.popitem(last=False)
-    rec.send_chunks(chunks)
+    if chunks is None:
+        logged(rec)
+    else:
+        rec.send_chunks(chunks)
 
 
 def _prepare(rr: Any, logged: Callable[[Any], None]) -> list[Any] | None:

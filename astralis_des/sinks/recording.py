@@ -4,7 +4,6 @@ trails, each robot's task and the events as text, on one ``sim_time`` timeline."
 from __future__ import annotations
 
 from collections.abc import Generator, Mapping, Sequence
-from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -155,14 +154,16 @@ class RerunRecorder:
             pts = np.array(robot.trail_p, dtype=float)
             color = palette[rid]
             log_body(rr, rec, robot, color)
-            send_prepared(rr, rec, ("robot", rid, color, bool(robot.plans)), None,
-                          partial(log_robot_looks, rr, rid, color, bool(robot.plans)))
+            rec.log(paths.robot_pose(rid), rr.Points3D.from_fields(
+                radii=0.35, colors=[color], labels=[rid]), static=True)
             rec.log(paths.robot_trail(rid), rr.LineStrips3D([pts], colors=[color], radii=0.05),
                     static=True)
             if robot.plans:  # each leg's planned path, from when it was set out on
                 rec.send_columns(paths.robot_plan(rid), indexes=[rr.TimeColumn(
                     paths.TIMELINE, duration=[t for t, _ in robot.plans])],
                     columns=rr.LineStrips3D.columns(strips=[p for _, p in robot.plans]))
+                rec.log(paths.robot_plan(rid), rr.LineStrips3D.from_fields(
+                    colors=[(*color[:3], 140)], radii=0.03), static=True)
         self._log_replay(result, perception)
         close_and_check(rec, self.path)  # Rerun's file sink only logs a failed write
 
@@ -216,16 +217,6 @@ class RerunRecorder:
             cameras=cameras, hidden=above(sim.world, shown),
             sensed=sorted({rid for rid, _ in sim.pose_sensors.sensors}), graph=graph,
             matrix=Grid.largest(sim.rounds).bounds()))
-
-
-def log_robot_looks(rr: Any, rid: str, color: tuple[int, int, int, int], planned: bool,
-                    rec: Any) -> None:
-    """A robot's static looks: its pose's dot and label, its plans' colour."""
-    rec.log(paths.robot_pose(rid), rr.Points3D.from_fields(radii=0.35, colors=[color],
-                                                           labels=[rid]), static=True)
-    if planned:
-        rec.log(paths.robot_plan(rid), rr.LineStrips3D.from_fields(
-            colors=[(*color[:3], 140)], radii=0.03), static=True)
 
 
 def above(world: World, shown: Sequence[Any]) -> list[str]:
