@@ -32,6 +32,7 @@ SAMPLES = 5  # per side of each face, where something may hide part of the targe
 # showing over a cabinet must meet a sample: 3 a side left a top sixth unsampled)
 COARSE = 3  # per side, for the unhidden bound (an area sum: accurate at 3 already)
 NEAR = 0.05  # m: the renderer's near plane
+SWATH_ROWS = 8  # offsets across the track judged at a time by swath
 Sight = Callable[[FloatArray, FloatArray], np.ndarray]  # (eyes, points) -> clear
 
 
@@ -139,7 +140,16 @@ def _swath(view: View, drop: float) -> float:
     xs = np.arange(-reach, reach + 1e-9, 0.05)  # along the track
 
     def widest(ys: FloatArray) -> float | None:
-        """The largest offset across the track in ``ys`` at which the target is detected."""
+        """The largest offset across the track in ``ys`` at which the target is detected:
+        rows of ``ys`` judged a block at a time from the widest (each on its own, so the
+        first block with a detection holds the answer)."""
+        for stop in range(len(ys), 0, -SWATH_ROWS):
+            found = widest_of(ys[max(stop - SWATH_ROWS, 0):stop])
+            if found is not None:
+                return found
+        return None
+
+    def widest_of(ys: FloatArray) -> float | None:
         gx, gy = np.meshgrid(xs, ys, indexing="ij")
         centres = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, -drop)])
         eye, size = np.zeros((1, 3)), np.asarray(TARGET_SIZE, dtype=float)

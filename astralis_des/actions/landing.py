@@ -51,15 +51,17 @@ def landing_way(ctx: Context, robot: Robot) -> FloatArray:
     scene.furnish(rooms)  # the room it lands in, with its furniture
     taken = _taken(ctx, robot, here, rooms)
     solid = scene.blockers(rooms)
-    for reach in LANDING_RINGS:
-        angles = np.linspace(0.0, 2 * np.pi, 1 if reach == 0 else 12, endpoint=False)
-        for angle in angles:
-            spot = here + reach * np.array([np.cos(angle), np.sin(angle), 0.0])
-            if _free(taken, spot[None, :], floor)[0] and \
-                    _supported(ctx, spot[None, :], floor)[0] and (reach == 0 or (
-                    _in(ctx, spot, floor, room) and bool(scene.line_of_sight(here, spot)[0])
-                    and _clears(solid, here, spot))):
-                return np.vstack([here, spot]) if reach else here[None, :]
+    rings = _rings(here)
+    # the cheap tests of every spot on the rings at once, the rest one spot at a time in order
+    ok = _free(taken, rings, floor)
+    ok[ok] = _supported(ctx, rings[ok], floor)
+    for k in np.flatnonzero(ok):
+        spot = rings[k]
+        if k == 0:
+            return here[None, :]
+        if _in(ctx, spot, floor, room) and bool(scene.line_of_sight(here, spot)[0]) \
+                and _clears(solid, here, spot):
+            return np.vstack([here, spot])
     searches = [_grid(ctx, here, here, floor, room)]
     if room is not None:  # none in its room: out of its door, to the corridor
         door = np.array([*room.door.center[:2], here[2]])
@@ -78,15 +80,25 @@ def landing_way(ctx: Context, robot: Robot) -> FloatArray:
     return here[None, :]
 
 
+def _rings(here: FloatArray) -> FloatArray:
+    """The spots on ``LANDING_RINGS`` around ``here``, nearest ring first (``here`` first)."""
+    spots = []
+    for reach in LANDING_RINGS:
+        angles = np.linspace(0.0, 2 * np.pi, 1 if reach == 0 else 12, endpoint=False)
+        spots += [here + reach * np.array([np.cos(angle), np.sin(angle), 0.0])
+                  for angle in angles]
+    return np.array(spots)
+
+
 def _nearest_way(ctx: Context, robot: Robot, here: FloatArray, spots: FloatArray,
                  solid: FloatArray) -> FloatArray | None:
     """The way to the nearest of the free ``spots`` reached in a straight line (of the
     ``IN_LINE`` nearest), else by a route to one of the ``ROUTED`` nearest; None if
     neither."""
     spots = spots[np.argsort(np.linalg.norm(spots[:, :2] - here[:2], axis=1), kind="stable")]
-    for spot in spots[:IN_LINE]:
-        if _clears(solid, here, spot):
-            return np.vstack([here, spot])
+    first = _first_clear(solid, here, spots[:IN_LINE])
+    if first is not None:
+        return np.vstack([here, spots[first]])
     for spot in spots[:ROUTED]:
         way = route(ctx, robot, ctx.world.on_floor(spot))
         if way.points is not None:
@@ -180,14 +192,14 @@ def _grid(ctx: Context, here: FloatArray, centre: FloatArray, floor: float,
     for k in np.flatnonzero(np.all((boxes[:, 0, :2] <= hi) & (boxes[:, 1, :2] >= lo), axis=1)):
         inside |= np.all((at >= boxes[k, 0]) & (at <= boxes[k, 1]), axis=1)
     spots = spots[~inside]
-    same = np.array([abs(ctx.world.floor_below(p) - floor) < 0.05 for p in spots], dtype=bool)
+    same = np.abs(ctx.world.floors_below(spots) - floor) < 0.05
     return spots[same] if len(spots) else spots
 
 
 def _clears(solid: FloatArray, here: FloatArray, spot: FloatArray) -> bool:
     """Does a UAV flying level from ``here`` to ``spot`` keep its square clear of ``solid``
     (walls, door jambs, furniture) all the way?"""
-    steps = max(int(np.ceil(float(np.linalg.norm(spot - here)) / 0.1)), 1)
+    steps = _steps(here, spot)
     pts = here + np.outer(np.linspace(0.0, 1.0, steps + 1), spot - here)
     lo = np.column_stack([pts[:, :2] - BODY_CLEAR, pts[:, 2] - BODY_BAND])
     hi = np.column_stack([pts[:, :2] + BODY_CLEAR, pts[:, 2] + BODY_BAND])
@@ -195,6 +207,37 @@ def _clears(solid: FloatArray, here: FloatArray, spot: FloatArray) -> bool:
     boxes = solid[near]
     hit = np.all((boxes[None, :, 0] < hi[:, None]) & (boxes[None, :, 1] > lo[:, None]), axis=2)
     return not bool(hit.any())
+
+
+def _first_clear(solid: FloatArray, here: FloatArray, spots: FloatArray,
+                 block: int = 32) -> int | None:
+    """The first of ``spots`` that :func:`_clears` (the same test, ``block`` spots at a
+    time), or None."""
+    for start in range(0, len(spots), block):
+        part = spots[start:start + block]
+        steps = np.array([_steps(here, spot) for spot in part])
+        # each spot's points, as np.linspace(0, 1, steps + 1) places them
+        which = np.repeat(np.arange(len(part)), steps + 1)
+        first = np.concatenate([[0], np.cumsum(steps + 1)[:-1]])
+        k = np.arange(len(which)) - first[which]
+        t = k * (1.0 / steps[which])
+        t[first[1:] - 1] = 1.0
+        t[-1] = 1.0
+        pts = here + t[:, None] * (part - here)[which]
+        lo = np.column_stack([pts[:, :2] - BODY_CLEAR, pts[:, 2] - BODY_BAND])
+        hi = np.column_stack([pts[:, :2] + BODY_CLEAR, pts[:, 2] + BODY_BAND])
+        near = np.all((solid[:, 0] < hi.max(axis=0)) & (solid[:, 1] > lo.min(axis=0)), axis=1)
+        boxes = solid[near]
+        hit = np.all((boxes[None, :, 0] < hi[:, None]) & (boxes[None, :, 1] > lo[:, None]),
+                     axis=2).any(axis=1)
+        clear = np.flatnonzero(np.bincount(which, weights=hit, minlength=len(part)) == 0)
+        if len(clear):
+            return start + int(clear[0])
+    return None
+
+
+def _steps(here: FloatArray, spot: FloatArray) -> int:
+    return max(int(np.ceil(float(np.linalg.norm(spot - here)) / 0.1)), 1)
 
 
 def _along(loop: FloatArray, size: tuple[float, float, float]) -> FloatArray:

@@ -77,37 +77,37 @@ def build(points: FloatArray, speed: float, accel: float | None = None,
     n = len(lengths)
     headings = np.arctan2(legs[:, 1], legs[:, 0]) if n else np.zeros(0)
     flat = np.hypot(legs[:, 0], legs[:, 1]) > 1e-6 if n else np.zeros(0, dtype=bool)
+    # plain floats in the loops below (numpy scalars cost more each; the same arithmetic)
+    length = lengths.tolist()
     turns = np.zeros(n)  # turning on the spot before each leg, radians
     if turn_rate is not None:
         previous = heading
-        for i in range(n):
-            if flat[i] and lengths[i] >= MIN_TURN_LEG:
-                turns[i] = abs(math.remainder(headings[i] - previous, math.tau))
-                previous = headings[i]
+        for i, (ahead, level) in enumerate(zip(headings.tolist(), flat.tolist(), strict=True)):
+            if level and length[i] >= MIN_TURN_LEG:
+                turns[i] = abs(math.remainder(ahead - previous, math.tau))
+                previous = ahead
         turns = np.where(turns > STOP_ANGLE, turns - STOP_ANGLE, 0.0)
     # speed allowed at each vertex: 0 at the ends, at turns on the spot, reduced at corners
-    v = np.full(n + 1, speed)
+    v = [float(speed)] * (n + 1)
     if accel is not None:
         v[0] = v[-1] = 0.0
         for i in range(1, n):
-            cos = float(legs[i - 1] @ legs[i]) / (lengths[i - 1] * lengths[i])
+            cos = float(legs[i - 1] @ legs[i]) / (length[i - 1] * length[i])
             v[i] = speed * max((1 + cos) / 2, MIN_CORNER)
-        for i in range(n):
-            v[i + 1] = min(v[i + 1], math.sqrt(v[i] ** 2 + 2 * accel * lengths[i]))
-        for i in range(n - 1, -1, -1):
-            v[i] = min(v[i], math.sqrt(v[i + 1] ** 2 + 2 * accel * lengths[i]))
+        _limit(v, length, accel)
     if turn_rate is not None:
-        v[:-1][turns > 0] = 0.0
+        for i in np.flatnonzero(turns > 0).tolist():
+            v[i] = 0.0
         if accel is not None:  # braking before a stop
-            for i in range(n - 1, -1, -1):
-                v[i] = min(v[i], math.sqrt(v[i + 1] ** 2 + 2 * accel * lengths[i]))
+            _limit(v, length, accel, forward=False)
+    turn = turns.tolist()
     phases: list[tuple[float, float, float, float]] = []  # start time, arc, speed, accel
     t = s = 0.0
     for i in range(n):
-        if turns[i] > 0 and turn_rate is not None:
+        if turn[i] > 0 and turn_rate is not None:
             phases.append((t, s, 0.0, 0.0))
-            t += turns[i] / turn_rate
-        for dur, v0, acc, dist in _trapezoid(lengths[i], v[i], v[i + 1], speed, accel):
+            t += turn[i] / turn_rate
+        for dur, v0, acc, dist in _trapezoid(length[i], v[i], v[i + 1], speed, accel):
             if dur > 0:
                 phases.append((t, s, v0, acc))
                 t += dur
@@ -115,6 +115,16 @@ def build(points: FloatArray, speed: float, accel: float | None = None,
     phases.append((t, s, 0.0, 0.0))
     cols = np.array(phases).T
     return Profile(cols[0], cols[1], cols[2], cols[3], t, headings)
+
+
+def _limit(v: list[float], length: list[float], accel: float, forward: bool = True) -> None:
+    """Lower the speeds at the vertices to what ``accel`` reaches over each leg: from the
+    start forwards (then back from the end), or back from the end only."""
+    if forward:
+        for i in range(len(length)):
+            v[i + 1] = min(v[i + 1], math.sqrt(v[i] ** 2 + 2 * accel * length[i]))
+    for i in range(len(length) - 1, -1, -1):
+        v[i] = min(v[i], math.sqrt(v[i + 1] ** 2 + 2 * accel * length[i]))
 
 
 def _trapezoid(length: float, v0: float, v1: float, vmax: float,

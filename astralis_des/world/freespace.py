@@ -147,6 +147,8 @@ def slice_segments(vertices: FloatArray, faces: IntArray, z: float) -> FloatArra
 
 def winding(points: FloatArray, segments: FloatArray) -> IntArray:
     """Winding number of each point about the oriented segments (Sunday's crossing rule)."""
+    # a level segment never crosses a ray towards +x: it counts for no point
+    segments = segments[segments[:, 0, 1] != segments[:, 1, 1]]
     if len(segments) == 0:
         return np.zeros(len(points), dtype=np.int64)
     p, q = segments[None, :, 0], segments[None, :, 1]

@@ -53,27 +53,42 @@ def segments_hit_boxes(p0: FloatArray, p1: FloatArray, boxes: FloatArray) -> NDA
     # Only boxes whose extent meets the segments' common bounding box can be hit.
     lo = np.minimum(p0.min(axis=0), p1.min(axis=0))
     hi = np.maximum(p0.max(axis=0), p1.max(axis=0))
-    near = np.all((boxes[:, 0] <= hi) & (boxes[:, 1] >= lo), axis=1)
+    near = ((boxes[:, 0, 0] <= hi[0]) & (boxes[:, 1, 0] >= lo[0]) & (boxes[:, 0, 1] <= hi[1])
+            & (boxes[:, 1, 1] >= lo[1]) & (boxes[:, 0, 2] <= hi[2]) & (boxes[:, 1, 2] >= lo[2]))
     candidates = boxes[near]
     if len(candidates) == 0:
         return np.zeros(len(p0), dtype=bool)
-    d = (p1 - p0)[:, None, :]
-    origin = p0[:, None, :]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / d
-        t_a = (candidates[None, :, 0, :] - origin) * inv
-        t_b = (candidates[None, :, 1, :] - origin) * inv
-    t_near = np.where(np.isnan(t_a), -np.inf, np.minimum(t_a, t_b))
-    t_far = np.where(np.isnan(t_b), np.inf, np.maximum(t_a, t_b))
-    # A zero direction component: the segment is inside the slab or never enters it.
-    parallel = d == 0.0
-    inside = (origin >= candidates[None, :, 0, :]) & (origin <= candidates[None, :, 1, :])
-    t_near = np.where(parallel, np.where(inside, -np.inf, np.inf), t_near)
-    t_far = np.where(parallel, np.where(inside, np.inf, -np.inf), t_far)
-    enter = t_near.max(axis=2)
-    leave = t_far.min(axis=2)
+    d = p1 - p0
+    enter, leave = _slab(p0[:, 0:1], d[:, 0], candidates[None, :, 0, 0], candidates[None, :, 1, 0])
+    for k in (1, 2):  # one axis at a time: (M, K) arrays, not (M, K, 3)
+        t_near, t_far = _slab(p0[:, k:k + 1], d[:, k], candidates[None, :, 0, k],
+                              candidates[None, :, 1, k])
+        enter, leave = np.maximum(enter, t_near), np.minimum(leave, t_far)
     hit = (enter <= leave) & (leave >= 0.0) & (enter <= 1.0)
     return np.asarray(hit.any(axis=1))
+
+
+def _slab(origin: FloatArray, d: FloatArray, lo: FloatArray,
+          hi: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Where segments (``origin`` ``(M, 1)``, direction ``d`` ``(M,)``) enter and leave the
+    slabs ``lo..hi`` (``(1, K)``) of one axis, in units of the segment."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = (1.0 / d)[:, None]
+        t_a = (lo - origin) * inv
+        t_b = (hi - origin) * inv
+    t_near, t_far = np.minimum(t_a, t_b), np.maximum(t_a, t_b)
+    nan_a, nan_b = np.isnan(t_a), np.isnan(t_b)
+    if nan_a.any():
+        t_near[nan_a] = -np.inf
+    if nan_b.any():
+        t_far[nan_b] = np.inf
+    # A zero direction component: the segment is inside the slab or never enters it.
+    parallel = d == 0.0
+    if parallel.any():
+        inside = (origin[parallel] >= lo) & (origin[parallel] <= hi)
+        t_near[parallel] = np.where(inside, -np.inf, np.inf)
+        t_far[parallel] = np.where(inside, np.inf, -np.inf)
+    return t_near, t_far
 
 
 def polyline_length(points: FloatArray) -> float:

@@ -88,6 +88,22 @@ def erode_near(walk: BoolArray, radius: float, changed: Cells, before: BoolArray
     return out
 
 
+def erode_without(before: BoolArray, radius: float, lost: Cells) -> BoolArray:
+    """:func:`erode` of a walk that lost the rectangle of cells ``lost`` (all of them walk
+    before) from the walk eroded to ``before``: a cell stays when its disk misses the
+    rectangle, i.e. ``before`` less the rectangle grown by the disk (a union of rectangles,
+    as in :func:`erode`)."""
+    out = before.copy()
+    (i0, i1), (j0, j1) = (lost[0].start, lost[0].stop), (lost[1].start, lost[1].stop)
+    if i0 >= i1 or j0 >= j1:
+        return out
+    reach = math.floor(radius + 1e-9)
+    for di in range(reach + 1):
+        h = math.floor(math.sqrt(radius * radius - di * di) + 1e-9)
+        out[max(i0 - di, 0):i1 + di, max(j0 - h, 0):j1 + h] = False
+    return out
+
+
 def reachable(space: FreeSpace, taken: BoolArray, passage: float,
               walk_eroded: BoolArray | None = None) -> tuple[BoolArray, BoolArray]:
     """Free cells a robot ``passage`` wide can stand on, and those it reaches from the door;
@@ -100,3 +116,4 @@ def reachable(space: FreeSpace, taken: BoolArray, passage: float,
     from_door[labels[space.door & eroded]] = True
     from_door[0] = False
     return eroded, from_door[labels]
+

