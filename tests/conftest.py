@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import atexit
+import os
+import shutil
 import signal
+import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -19,6 +23,15 @@ from astralis_des.world.model import World
 # the suite takes it back: a handler here is reset to the default in each command started.
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+
+# The commands the tests start import the package anew. Where PYTHONDONTWRITEBYTECODE is set
+# (CI machines often set it), each would compile what it imports from source, a few tenths of
+# a second a command; they share one bytecode cache instead, in a temporary folder (the
+# checkout is left as it is), as a user's machine caches it.
+if os.environ.pop("PYTHONDONTWRITEBYTECODE", None) and "PYTHONPYCACHEPREFIX" not in os.environ:
+    _BYTECODE = tempfile.mkdtemp(prefix="astralis-tests-bytecode-")
+    os.environ["PYTHONPYCACHEPREFIX"] = _BYTECODE
+    atexit.register(shutil.rmtree, _BYTECODE, ignore_errors=True)
 
 if TYPE_CHECKING:
     from astralis_des.api.client import Client
