@@ -51,6 +51,8 @@ class EpisodeRun:
         self.offered: list[str] = []  # the rooms they may take now
         self.allowed: dict[str, set[str]] = {}  # per asked agent: the offered rooms it may take
         self.choices: dict[str, int] = {}  # answers so far at this decision time
+        self._asking = 0  # counts the times asked and answered (masks are built per time)
+        self._masks: dict[str, tuple[tuple[int, int, bool], np.ndarray]] = {}
         self.segment = ""
         self.pending: list[str] = []  # the segment's rooms not yet searched (or in flight)
         self.inflight: dict[str, tuple[str, simpy.Event]] = {}  # room -> searcher, its search
@@ -90,14 +92,18 @@ class EpisodeRun:
                     sim.log.emit("team_lost", segment=segment)
                     return "team_lost"
                 offered = [r for r in self.pending if r not in self.inflight]
-                if not self.inflight and not self._anyone_may(agents, offered):
-                    self._record(agents, offered, {})  # an empty round, as the paper logs it
-                    for room in offered:
-                        settle(sim, room, "no agent left that can search it")
-                    break
                 free = [r for r in agents if self._free(r)]
+                allowed = None  # who may take which offered room, once per pass
+                if not self.inflight:
+                    allowed = sim.allowed(agents, offered, sim.tried)
+                    if not allowed.any():
+                        self._record(agents, offered, {})  # an empty round, as the paper logs
+                        for room in offered:
+                            settle(sim, room, "no agent left that can search it")
+                        break
+                    allowed = allowed[[agents.index(r) for r in free]]
                 if free:
-                    self._open(free, offered)
+                    self._open(free, offered, allowed)
                     self._reply = sim.env.event()
                     self._ask.succeed()
                     yield self._reply
@@ -130,12 +136,13 @@ class EpisodeRun:
         hold = self.holds.get(robot.id)
         return not robot.faulted and self.idle(robot.id) and (hold is None or hold.processed)
 
-    def _anyone_may(self, agents: list[Robot], rooms: list[str]) -> bool:
-        return bool(self.sim.allowed(agents, rooms, self.sim.tried).any())
-
-    def _open(self, free: list[Robot], offered: list[str]) -> None:
+    def _open(self, free: list[Robot], offered: list[str], allowed: np.ndarray | None) -> None:
+        """Ask the ``free`` agents, who may take the ``allowed`` of the ``offered`` rooms
+        (``(free, offered)``; None: not known yet)."""
         self.asked, self.offered, self.choices = [r.id for r in free], offered, {}
-        allowed = self.sim.allowed(free, offered, self.sim.tried)
+        self._asking += 1
+        if allowed is None:
+            allowed = self.sim.allowed(free, offered, self.sim.tried)
         self.allowed = {r.id: {room for room, ok in zip(offered, allowed[i], strict=True) if ok}
                         for i, r in enumerate(free)}
 
@@ -156,6 +163,7 @@ class EpisodeRun:
             if self.choices.get(agent) == HOLD:
                 self._hold(self.sim.robots[agent])
         self.asked, self.choices = [], {}
+        self._asking += 1
 
     def _hold(self, robot: Robot) -> None:
         if (robot.kind, "hover") in ACTIONS:
@@ -201,16 +209,23 @@ class EpisodeRun:
 
     def mask(self, agent: str) -> np.ndarray:
         """The actions ``agent`` may take now (1) and may not (0)."""
+        return self._mask(agent).copy()
+
+    def _mask(self, agent: str) -> np.ndarray:
+        """:meth:`mask`, shared: built once per agent while the answers stay as they are."""
+        key = (self._asking, len(self.choices), self.ended)
+        known = self._masks.get(agent)
+        if known is not None and known[0] == key:
+            return known[1]
         out = np.zeros(self.layout.size, dtype=np.int8)
         if self.ended or agent not in self.asked or agent in self.choices:
             out[CONTINUE] = 1
-            return out
-        out[WAIT] = out[HOLD] = 1
-        taken = {self.layout.decode(c)[1] for c in self.choices.values()}
-        kind = self.sim.robots[agent].kind
-        for room in self.allowed[agent] - taken:
-            for action in searches_of(kind):
-                out[self.layout.index(room, action)] = 1
+        else:
+            out[WAIT] = out[HOLD] = 1
+            taken = {self.layout.decode(c)[1] for c in self.choices.values()}
+            rooms = [self.layout.room_index[r] for r in self.allowed[agent] if r not in taken]
+            out[self.layout.searches_by(self.sim.robots[agent].kind)[rooms]] = 1
+        self._masks[agent] = (key, out)
         return out
 
     def refusal(self, agent: str, action: int) -> str | None:
@@ -219,7 +234,7 @@ class EpisodeRun:
             name, room = self.layout.decode(int(action))
         except (IndexError, TypeError, ValueError):
             return f"action {action!r} is not an action index (0..{self.layout.size - 1})"
-        if self.mask(agent)[int(action)]:
+        if self._mask(agent)[int(action)]:
             return None
         if agent not in self.asked:
             return f"{agent} is busy: only continue"
