@@ -98,7 +98,7 @@ class Observer:
             room = index.get(task.room, -1) + 1 if task is not None and task.room else 0
             action = TASK_CODES[task.action] if task is not None and task.action in SEARCHES \
                 else 0
-            rows.append((*robot.position(now), robot.heading, not run.idle(rid),
+            rows.append((*robot.position(now).tolist(), robot.heading, not run.idle(rid),
                          robot.faulted, hold is not None and not hold.processed,
                          rid in run.asked, room, action))
         out = self._kinds.copy()
