@@ -53,6 +53,8 @@ class EpisodeRun:
         self.choices: dict[str, int] = {}  # answers so far at this decision time
         self._asking = 0  # counts the times asked and answered (masks are built per time)
         self._masks: dict[str, tuple[tuple[int, int, bool], np.ndarray]] = {}
+        self._reach: dict[tuple[str, bytes], dict[str, bool]] = {}  # (kind, where) -> room ->
+        # whether it gets there (the kernel's answer, which depends on nothing else)
         self.segment = ""
         self.pending: list[str] = []  # the segment's rooms not yet searched (or in flight)
         self.inflight: dict[str, tuple[str, simpy.Event]] = {}  # room -> searcher, its search
@@ -93,15 +95,12 @@ class EpisodeRun:
                     return "team_lost"
                 offered = [r for r in self.pending if r not in self.inflight]
                 free = [r for r in agents if self._free(r)]
-                allowed = None  # who may take which offered room, once per pass
-                if not self.inflight:
-                    allowed = sim.allowed(agents, offered, sim.tried)
-                    if not allowed.any():
-                        self._record(agents, offered, {})  # an empty round, as the paper logs
-                        for room in offered:
-                            settle(sim, room, "no agent left that can search it")
-                        break
-                    allowed = allowed[[agents.index(r) for r in free]]
+                allowed = self._who_may(agents, free, offered)
+                if allowed is None:
+                    self._record(agents, offered, {})  # an empty round, as the paper logs it
+                    for room in offered:
+                        settle(sim, room, "no agent left that can search it")
+                    break
                 if free:
                     self._open(free, offered, allowed)
                     self._reply = sim.env.event()
@@ -136,13 +135,33 @@ class EpisodeRun:
         hold = self.holds.get(robot.id)
         return not robot.faulted and self.idle(robot.id) and (hold is None or hold.processed)
 
-    def _open(self, free: list[Robot], offered: list[str], allowed: np.ndarray | None) -> None:
-        """Ask the ``free`` agents, who may take the ``allowed`` of the ``offered`` rooms
-        (``(free, offered)``; None: not known yet)."""
+    def _who_may(self, agents: list[Robot], free: list[Robot], offered: list[str]
+                 ) -> np.ndarray | None:
+        """``(free, offered)``: which of the rooms each free agent may take; None when no
+        search is in flight and no agent at all may take any (the rooms are settled)."""
+        if self.inflight:
+            return self._allowed(free, offered)
+        allowed = self._allowed(agents, offered)
+        return allowed[[agents.index(r) for r in free]] if allowed.any() else None
+
+    def _allowed(self, robots: list[Robot], rooms: list[str]) -> np.ndarray:
+        """``Simulation.allowed`` (not tried by the kind, reached from where it stands), the
+        kernel asked once per position: a free robot stands still between decisions."""
+        tried, now = self.sim.tried, self.sim.env.now
+        rows = []
+        for robot in robots:
+            known = self._reach.setdefault((robot.kind, robot.position(now).tobytes()), {})
+            missing = [room for room in rooms if room not in known]
+            if missing:
+                known.update(zip(missing, self.sim.reaches(robot, missing), strict=True))
+            rows.append([robot.kind not in tried.get(room, ()) and known[room] for room in rooms])
+        return np.array(rows, dtype=bool).reshape(len(robots), len(rooms))
+
+    def _open(self, free: list[Robot], offered: list[str], allowed: np.ndarray) -> None:
+        """Ask the ``free`` agents, who may take the ``allowed`` (``(free, offered)``) of the
+        ``offered`` rooms."""
         self.asked, self.offered, self.choices = [r.id for r in free], offered, {}
         self._asking += 1
-        if allowed is None:
-            allowed = self.sim.allowed(free, offered, self.sim.tried)
         self.allowed = {r.id: {room for room, ok in zip(offered, allowed[i], strict=True) if ok}
                         for i, r in enumerate(free)}
 

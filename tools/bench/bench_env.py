@@ -42,8 +42,8 @@ DEFAULT = ROOT / "missions" / "urban_search.yaml"
 
 class Clock:
     """Wall seconds by part, while stepping: ``kernel`` (the run between decisions, less the
-    env's rounds inside it), ``env_inside`` (the env's rounds: asking, committing, booking),
-    ``policy``, ``reset`` and ``end`` (ending runs, in ``kernel``)."""
+    env's rounds inside it), ``env_inside`` (the env's rounds: who may take what, asking,
+    committing, booking), ``policy``, ``reset`` and ``end`` (ending runs, in ``kernel``)."""
 
     def __init__(self) -> None:
         self.zero()
@@ -85,7 +85,7 @@ def _timed_finish(self: Simulation) -> Any:
 
 EpisodeRun._run = _timed_run  # type: ignore[method-assign]
 Simulation.finish = _timed_finish  # type: ignore[method-assign]
-for _name in ("_open", "_commit", "_book"):
+for _name in ("_who_may", "_open", "_commit", "_book"):
     setattr(EpisodeRun, _name, _env_side(getattr(EpisodeRun, _name)))
 
 
