@@ -279,13 +279,14 @@ class EpisodeRun:
         """Whether every asked agent has answered."""
         return all(a in self.choices for a in self.asked)
 
-    def advance(self) -> Progress:
-        """Commit the answers and run the kernel to the next decision time (or the end)."""
+    def advance(self, refused: dict[str, int] | None = None) -> Progress:
+        """Commit the answers and run the kernel to the next decision time (or the end);
+        ``refused``: the actions refused at this decision time, by agent."""
         assert self._reply is not None and not self.ended
         self._reply.succeed()
         self._ask = self.sim.env.event()
         self._run()
-        return self.progress()
+        return self.progress(refused)
 
     def _run(self) -> None:
         if not self.sim.ended:
