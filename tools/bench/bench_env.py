@@ -1,7 +1,7 @@
 """Environment benchmark: decisions per second through ``astralis_des.env``, and the env's
 overhead over the kernel running the same decisions itself.
 
-    python tools/bench/bench_env.py [--episodes 40] [--physics 2]
+    python tools/bench/bench_env.py [--episodes 40] [--physics 2] [--cpu]
 
 - *random*: ``MissionEnv.step`` with a random valid action (from the mask), observation
   building included, kinematic fidelity, default team; episodes over different seeds, and the
@@ -11,7 +11,8 @@ overhead over the kernel running the same decisions itself.
   going), the env's own (observations, masks, rounds, rewards, selection) and the policy's;
   ``env/kernel`` is their ratio, and ``kernel-bound`` the decisions/s if the env cost
   nothing; ``end s`` is the kernel's part spent ending episodes (the UAVs land). ``reset s``
-  (a new run to its first decision) is apart, as the issue measured.
+  (a new run to its first decision) is apart, as the issue measured. ``--cpu`` times this
+  process's CPU time instead of the wall's (others benchmarking on the same cores).
 - *overhead*: the mixed heuristic as a policy through the env against ``Simulation.run`` with
   the mixed strategy, the same missions (the env reproduces the run's event log byte for
   byte): wall time of one over the other. Goal (issue 22): at most 1.3x.
@@ -46,6 +47,7 @@ class Clock:
     committing, booking), ``policy``, ``reset`` and ``end`` (ending runs, in ``kernel``)."""
 
     def __init__(self) -> None:
+        self.now = time.perf_counter  # or time.process_time (--cpu)
         self.zero()
 
     def zero(self) -> None:
@@ -57,18 +59,18 @@ _run = EpisodeRun._run
 
 
 def _timed_run(self: EpisodeRun) -> None:
-    t0, inside = time.perf_counter(), CLOCK.env_inside
+    t0, inside = CLOCK.now(), CLOCK.env_inside
     _run(self)
-    CLOCK.kernel += time.perf_counter() - t0 - (CLOCK.env_inside - inside)
+    CLOCK.kernel += CLOCK.now() - t0 - (CLOCK.env_inside - inside)
 
 
 def _env_side(method: Callable[..., Any]) -> Callable[..., Any]:
     def timed(self: EpisodeRun, *args: Any) -> Any:
-        t0 = time.perf_counter()
+        t0 = CLOCK.now()
         try:
             return method(self, *args)
         finally:
-            CLOCK.env_inside += time.perf_counter() - t0
+            CLOCK.env_inside += CLOCK.now() - t0
     return timed
 
 
@@ -76,11 +78,11 @@ _finish = Simulation.finish
 
 
 def _timed_finish(self: Simulation) -> Any:
-    t0 = time.perf_counter()
+    t0 = CLOCK.now()
     try:
         return _finish(self)
     finally:
-        CLOCK.end += time.perf_counter() - t0
+        CLOCK.end += CLOCK.now() - t0
 
 
 EpisodeRun._run = _timed_run  # type: ignore[method-assign]
@@ -97,9 +99,9 @@ def episodes(env: MissionEnv, seeds: list[int], policy: str) -> tuple[int, float
     CLOCK.zero()
     for seed in seeds:
         kept = CLOCK.kernel, CLOCK.env_inside, CLOCK.end
-        t0 = time.perf_counter()
+        t0 = CLOCK.now()
         env.reset(seed=seed)  # its run to the first decision counts as the reset's
-        t1 = time.perf_counter()
+        t1 = CLOCK.now()
         CLOCK.reset += t1 - t0
         CLOCK.kernel, CLOCK.env_inside, CLOCK.end = kept
         for agent in env.agent_iter():
@@ -107,12 +109,12 @@ def episodes(env: MissionEnv, seeds: list[int], policy: str) -> tuple[int, float
             if term or trunc:
                 env.step(None)
                 continue
-            p0 = time.perf_counter()
+            p0 = CLOCK.now()
             action = random_policy(obs, rng) if policy == "random" else mixed_policy(env, agent)
-            CLOCK.policy += time.perf_counter() - p0
+            CLOCK.policy += CLOCK.now() - p0
             env.step(action)
             decisions += 1
-        wall += time.perf_counter() - t1
+        wall += CLOCK.now() - t1
         simulated += env.mission_run.sim.env.now
     return decisions, wall, simulated
 
@@ -123,9 +125,9 @@ def kernel(seeds: list[int]) -> float:
     wall = 0.0
     for seed in seeds:
         mission = base.with_changes(seed=seed)
-        t0 = time.perf_counter()
+        t0 = CLOCK.now()
         Simulation(mission).run()
-        wall += time.perf_counter() - t0
+        wall += CLOCK.now() - t0
     return wall
 
 
@@ -133,12 +135,17 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--episodes", type=int, default=40)
     parser.add_argument("--physics", type=int, default=2, help="physics episodes (0: none)")
+    parser.add_argument("--cpu", action="store_true",
+                        help="this process's CPU time instead of wall time (a shared machine)")
     args = parser.parse_args()
+    if args.cpu:
+        CLOCK.now = time.process_time
     seeds = list(range(1, args.episodes + 1))
     env = MissionEnv(DEFAULT)
     episodes(env, [1000], "random")  # imports, the world's first caches
     print("Goal (issue 43): random policy >= 2,000 decisions/s")
-    print(f"{'kinematic, default team':34} {'decisions':>9} {'wall s':>7} {'decisions/s':>11}"
+    print(f"{'kinematic, default team':34} {'decisions':>9} {'cpu s' if args.cpu else 'wall s':>7} "
+          f"{'decisions/s':>11}"
           f"   {'kernel s':>8} {'env s':>6} {'policy s':>8} {'env/kernel':>10}"
           f" {'kernel-bound':>12} {'end s':>5} {'reset s':>7}")
     for label, these in (("random, a new seed each episode", seeds),
