@@ -8,7 +8,6 @@ time. A busy robot is never asked.
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -61,8 +60,7 @@ class MissionEnv(Front, AECEnv[str, dict[str, Any], int]):
         refused = {agent: 1} if why is not None else {}
         self.infos[agent] = {"refused": why} if why is not None else {}
         if run.complete:
-            progress = run.advance()
-            progress = replace(progress, refused=refused)
+            progress = run.advance(refused)
             self.rewards = self.episodes.rewards_of(progress, self.agents)
             terminated, truncated = self.episodes.ended_how()
             for a in self.agents:

@@ -13,6 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cache, cached_property
 
+import numpy as np
+
 from astralis_des.actions import ACTIONS
 from astralis_des.kinds import KINDS
 
@@ -37,6 +39,20 @@ class Layout:
     @cached_property
     def room_index(self) -> dict[str, int]:
         return {room: k for k, room in enumerate(self.rooms)}
+
+    @cached_property
+    def _search_rows(self) -> dict[str, np.ndarray]:
+        return {}  # kind -> searches_by(kind), filled as kinds are asked for
+
+    def searches_by(self, kind: str) -> np.ndarray:
+        """``(rooms, the kind's searches)``: the action indices of each room's searches that
+        ``kind`` has (for masks)."""
+        rows = self._search_rows.get(kind)
+        if rows is None:
+            actions = np.array([SEARCHES.index(a) for a in searches_of(kind)], dtype=np.intp)
+            rows = len(SPECIAL) + np.arange(len(self.rooms))[:, None] * len(SEARCHES) + actions
+            self._search_rows[kind] = rows
+        return rows
 
     def index(self, room: str, action: str) -> int:
         """The action that searches ``room`` with ``action``."""

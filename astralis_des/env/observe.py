@@ -56,7 +56,8 @@ def state_space(n_agents: int, n_rooms: int) -> spaces.Box:
 
 
 class Observer:
-    """Builds observations; what all agents share is built once per decision time."""
+    """Builds observations; what all agents share is built once per decision time, from
+    tables of what does not change in an episode (kinds, the rooms' places and areas)."""
 
     def __init__(self, run: EpisodeRun) -> None:
         self.run = run
@@ -67,6 +68,12 @@ class Observer:
             room = sim.world.rooms[rid]
             self._static[j, 8:11] = room.center
             self._static[j, 11] = room.area
+        self._kinds = np.zeros((len(run.order), AGENT_COLUMNS), dtype=np.float32)
+        for i, rid in enumerate(run.order):
+            self._kinds[i, KINDS.index(sim.robots[rid].kind)] = 1.0
+        self._me = {rid: np.eye(len(run.order), dtype=np.float32)[i]
+                    for i, rid in enumerate(run.order)}
+        self._rows = np.arange(len(rooms))
         self._key: tuple[Any, ...] | None = None
         self._shared: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
@@ -82,61 +89,57 @@ class Observer:
 
     def _agents(self) -> np.ndarray:
         run, sim = self.run, self.run.sim
-        now = sim.env.now
-        out = np.zeros((len(run.order), AGENT_COLUMNS), dtype=np.float32)
-        for i, rid in enumerate(run.order):
+        now, index = sim.env.now, run.layout.room_index
+        rows = []
+        for rid in run.order:
             robot = sim.robots[rid]
-            out[i, KINDS.index(robot.kind)] = 1.0
-            out[i, 3:6] = robot.position(now)
-            out[i, 6] = robot.heading
-            handler = sim.handler(rid)
             hold = run.holds.get(rid)
-            out[i, 7] = not run.idle(rid)
-            out[i, 8] = robot.faulted
-            out[i, 9] = hold is not None and not hold.processed
-            out[i, 10] = rid in run.asked
-            task = handler.current
-            if task is not None and task.room in run.layout.room_index:
-                out[i, 11] = run.layout.room_index[task.room] + 1
-            if task is not None and task.action in SEARCHES:
-                out[i, 12] = SEARCHES.index(task.action) + 1
+            task = sim.handler(rid).current
+            room = index.get(task.room, -1) + 1 if task is not None and task.room else 0
+            action = TASK_CODES[task.action] if task is not None and task.action in SEARCHES \
+                else 0
+            rows.append((*robot.position(now).tolist(), robot.heading, not run.idle(rid),
+                         robot.faulted, hold is not None and not hold.processed,
+                         rid in run.asked, room, action))
+        out = self._kinds.copy()
+        out[:, 3:] = rows
         return out
 
     def _rooms(self) -> np.ndarray:
         run, sim = self.run, self.run.sim
         out = self._static.copy()
         pending, searched = set(run.pending), set(sim.searched)
-        for j, rid in enumerate(run.layout.rooms):
+        states, coverage, risk, messiness = [], [], [], []
+        for rid in run.layout.rooms:
             if rid in run.inflight:
-                column = 2
+                states.append(2)
             elif rid in searched:
-                column = 3
+                states.append(3)
             elif rid in run.given_up:
-                column = 4
+                states.append(4)
             else:  # open now (the segment's), or waiting for its segment
-                column = 1 if rid in pending else 0
-            out[j, column] = 1.0
-            out[j, 5] = run.coverage.get(rid, 0.0)
+                states.append(1 if rid in pending else 0)
+            coverage.append(run.coverage.get(rid, 0.0))
             state = sim.rooms[rid]
-            out[j, 6], out[j, 7] = state.risk, state.messiness
+            risk.append(state.risk)
+            messiness.append(state.messiness)
+        out[self._rows, states] = 1.0
+        out[:, 5], out[:, 6], out[:, 7] = coverage, risk, messiness
         return out
 
     def observe(self, agent: str) -> dict[str, Any]:
         run = self.run
         time, agents, rooms = self.shared()
-        me = np.zeros(len(run.order), dtype=np.float32)
-        me[run.order.index(agent)] = 1.0
         queue = np.zeros((QUEUE, 2), dtype=np.float32)
         handler = run.sim.handler(agent)
         tasks = ([handler.current] if handler.current is not None else []) + handler.queued
         for k, task in enumerate(tasks[:QUEUE]):
             queue[k, 0] = run.layout.room_index.get(task.room or "", -1) + 1
             queue[k, 1] = TASK_CODES.get(task.action, 0)
-        return {"observation": {"time": time, "me": me, "agents": agents, "queue": queue,
-                                "rooms": rooms},
+        return {"observation": {"time": time, "me": self._me[agent].copy(), "agents": agents,
+                                "queue": queue, "rooms": rooms},
                 "action_mask": run.mask(agent)}
 
     def state(self) -> np.ndarray:
         time, agents, rooms = self.shared()
         return np.concatenate([time, agents.ravel(), rooms.ravel()])
-

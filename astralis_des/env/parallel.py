@@ -8,7 +8,6 @@ same room: the first in team order takes it, the other is refused and waits.
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -59,7 +58,7 @@ class ParallelMissionEnv(Front, ParallelEnv[str, dict[str, Any], int]):
             if why is not None:
                 infos[agent]["refused"] = why
                 refused[agent] = 1
-        progress = replace(run.advance(), refused=refused)
+        progress = run.advance(refused)
         rewards = self.episodes.rewards_of(progress, self.agents)
         terminated, truncated = self.episodes.ended_how()
         observations = self._observations()

@@ -51,6 +51,10 @@ class EpisodeRun:
         self.offered: list[str] = []  # the rooms they may take now
         self.allowed: dict[str, set[str]] = {}  # per asked agent: the offered rooms it may take
         self.choices: dict[str, int] = {}  # answers so far at this decision time
+        self._asking = 0  # counts the times asked and answered (masks are built per time)
+        self._masks: dict[str, tuple[tuple[int, int, bool], np.ndarray]] = {}
+        self._reach: dict[tuple[str, bytes], dict[str, bool]] = {}  # (kind, where) -> room ->
+        # whether it gets there (the kernel's answer, which depends on nothing else)
         self.segment = ""
         self.pending: list[str] = []  # the segment's rooms not yet searched (or in flight)
         self.inflight: dict[str, tuple[str, simpy.Event]] = {}  # room -> searcher, its search
@@ -90,14 +94,15 @@ class EpisodeRun:
                     sim.log.emit("team_lost", segment=segment)
                     return "team_lost"
                 offered = [r for r in self.pending if r not in self.inflight]
-                if not self.inflight and not self._anyone_may(agents, offered):
+                free = [r for r in agents if self._free(r)]
+                allowed = self._who_may(agents, free, offered)
+                if allowed is None:
                     self._record(agents, offered, {})  # an empty round, as the paper logs it
                     for room in offered:
                         settle(sim, room, "no agent left that can search it")
                     break
-                free = [r for r in agents if self._free(r)]
                 if free:
-                    self._open(free, offered)
+                    self._open(free, offered, allowed)
                     self._reply = sim.env.event()
                     self._ask.succeed()
                     yield self._reply
@@ -130,12 +135,33 @@ class EpisodeRun:
         hold = self.holds.get(robot.id)
         return not robot.faulted and self.idle(robot.id) and (hold is None or hold.processed)
 
-    def _anyone_may(self, agents: list[Robot], rooms: list[str]) -> bool:
-        return bool(self.sim.allowed(agents, rooms, self.sim.tried).any())
+    def _who_may(self, agents: list[Robot], free: list[Robot], offered: list[str]
+                 ) -> np.ndarray | None:
+        """``(free, offered)``: which of the rooms each free agent may take; None when no
+        search is in flight and no agent at all may take any (the rooms are settled)."""
+        if self.inflight:
+            return self._allowed(free, offered)
+        allowed = self._allowed(agents, offered)
+        return allowed[[agents.index(r) for r in free]] if allowed.any() else None
 
-    def _open(self, free: list[Robot], offered: list[str]) -> None:
+    def _allowed(self, robots: list[Robot], rooms: list[str]) -> np.ndarray:
+        """``Simulation.allowed`` (not tried by the kind, reached from where it stands), the
+        kernel asked once per position: a free robot stands still between decisions."""
+        tried, now = self.sim.tried, self.sim.env.now
+        rows = []
+        for robot in robots:
+            known = self._reach.setdefault((robot.kind, robot.position(now).tobytes()), {})
+            missing = [room for room in rooms if room not in known]
+            if missing:
+                known.update(zip(missing, self.sim.reaches(robot, missing), strict=True))
+            rows.append([robot.kind not in tried.get(room, ()) and known[room] for room in rooms])
+        return np.array(rows, dtype=bool).reshape(len(robots), len(rooms))
+
+    def _open(self, free: list[Robot], offered: list[str], allowed: np.ndarray) -> None:
+        """Ask the ``free`` agents, who may take the ``allowed`` (``(free, offered)``) of the
+        ``offered`` rooms."""
         self.asked, self.offered, self.choices = [r.id for r in free], offered, {}
-        allowed = self.sim.allowed(free, offered, self.sim.tried)
+        self._asking += 1
         self.allowed = {r.id: {room for room, ok in zip(offered, allowed[i], strict=True) if ok}
                         for i, r in enumerate(free)}
 
@@ -156,6 +182,7 @@ class EpisodeRun:
             if self.choices.get(agent) == HOLD:
                 self._hold(self.sim.robots[agent])
         self.asked, self.choices = [], {}
+        self._asking += 1
 
     def _hold(self, robot: Robot) -> None:
         if (robot.kind, "hover") in ACTIONS:
@@ -201,16 +228,23 @@ class EpisodeRun:
 
     def mask(self, agent: str) -> np.ndarray:
         """The actions ``agent`` may take now (1) and may not (0)."""
+        return self._mask(agent).copy()
+
+    def _mask(self, agent: str) -> np.ndarray:
+        """:meth:`mask`, shared: built once per agent while the answers stay as they are."""
+        key = (self._asking, len(self.choices), self.ended)
+        known = self._masks.get(agent)
+        if known is not None and known[0] == key:
+            return known[1]
         out = np.zeros(self.layout.size, dtype=np.int8)
         if self.ended or agent not in self.asked or agent in self.choices:
             out[CONTINUE] = 1
-            return out
-        out[WAIT] = out[HOLD] = 1
-        taken = {self.layout.decode(c)[1] for c in self.choices.values()}
-        kind = self.sim.robots[agent].kind
-        for room in self.allowed[agent] - taken:
-            for action in searches_of(kind):
-                out[self.layout.index(room, action)] = 1
+        else:
+            out[WAIT] = out[HOLD] = 1
+            taken = {self.layout.decode(c)[1] for c in self.choices.values()}
+            rooms = [self.layout.room_index[r] for r in self.allowed[agent] if r not in taken]
+            out[self.layout.searches_by(self.sim.robots[agent].kind)[rooms]] = 1
+        self._masks[agent] = (key, out)
         return out
 
     def refusal(self, agent: str, action: int) -> str | None:
@@ -219,7 +253,7 @@ class EpisodeRun:
             name, room = self.layout.decode(int(action))
         except (IndexError, TypeError, ValueError):
             return f"action {action!r} is not an action index (0..{self.layout.size - 1})"
-        if self.mask(agent)[int(action)]:
+        if self._mask(agent)[int(action)]:
             return None
         if agent not in self.asked:
             return f"{agent} is busy: only continue"
@@ -245,13 +279,14 @@ class EpisodeRun:
         """Whether every asked agent has answered."""
         return all(a in self.choices for a in self.asked)
 
-    def advance(self) -> Progress:
-        """Commit the answers and run the kernel to the next decision time (or the end)."""
+    def advance(self, refused: dict[str, int] | None = None) -> Progress:
+        """Commit the answers and run the kernel to the next decision time (or the end);
+        ``refused``: the actions refused at this decision time, by agent."""
         assert self._reply is not None and not self.ended
         self._reply.succeed()
         self._ask = self.sim.env.event()
         self._run()
-        return self.progress()
+        return self.progress(refused)
 
     def _run(self) -> None:
         if not self.sim.ended:
