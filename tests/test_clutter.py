@@ -296,3 +296,18 @@ def test_erosion_near_a_new_footprint_equals_eroding_the_whole_floor() -> None:
         after = walk.copy()
         after[changed] = False
         assert np.array_equal(erode_near(after, radius, changed, before), erode(after, radius))
+
+
+def test_summed_area_tables_count_the_cells_of_every_window() -> None:
+    """A summed-area table (accumulated in place) gives, for any window, the number of set
+    cells numpy counts in it."""
+    from astralis_des.world.grids import summed, window
+
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        mask = rng.random((int(rng.integers(1, 30)), int(rng.integers(1, 30)))) > 0.4
+        kx, ky = int(rng.integers(1, mask.shape[0] + 1)), int(rng.integers(1, mask.shape[1] + 1))
+        counts = window(summed(mask), kx, ky)
+        i, j = int(rng.integers(counts.shape[0])), int(rng.integers(counts.shape[1]))
+        assert counts[i, j] == mask[i:i + kx, j:j + ky].sum()
+        assert summed(mask)[-1, -1] == mask.sum()

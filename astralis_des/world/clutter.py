@@ -21,10 +21,8 @@ from astralis_des.world.catalogue import Catalogue, agree, avatar_size, default_
 from astralis_des.world.freespace import BoolArray, FreeSpace, room_free_space
 from astralis_des.world.geometry import Box
 from astralis_des.world.grids import (
-    Cells,
     erode,
-    erode_near,
-    erode_without,
+    eroded_after,
     padded,
     reachable,
     summed,
@@ -256,27 +254,15 @@ def place_in(space: FreeSpace, occupied: Occupancy, footprint: Sequence[float],
         box = _footprint_box(spot)
         before = (occupied.taken.copy(), occupied.halo.copy())
         occupied.stamp(space, box, clearance)
-        walk_eroded = _eroded_after(space, occupied, before[0], space.cells(box.lo, box.hi),
-                                    passage / 2 / space.cell)
+        stamped, radius = space.cells(box.lo, box.hi), passage / 2 / space.cell
+        walk_eroded = eroded_after(space, occupied.taken, occupied.walk_eroded, before[0],
+                                   stamped, radius)
         eroded, reach = reachable(space, occupied.taken, passage, walk_eroded)
         if not (eroded & occupied.reach & ~reach).any():
             occupied.reach, occupied.walk_eroded = reach, walk_eroded
             return spot
         occupied.taken, occupied.halo = before
     return "every spot tried cuts off free floor from the door"
-
-
-def _eroded_after(space: FreeSpace, occupied: Occupancy, taken_before: BoolArray,
-                  stamped: Cells, radius: float) -> BoolArray:
-    """The walkable floor eroded by ``radius`` cells once the cells ``stamped`` are taken:
-    from the erosion before, as the walk lost the whole rectangle (the usual case: a spot on
-    the room's free floor), or by eroding around it again."""
-    was = (space.free & ~taken_before)[stamped]
-    outside = (space.open_floor & ~space.inside)[stamped]
-    lost = was & ~outside
-    if lost.all():
-        return erode_without(occupied.walk_eroded, radius, stamped)
-    return erode_near(walkable(space, occupied.taken), radius, stamped, occupied.walk_eroded)
 
 
 @dataclass(frozen=True)

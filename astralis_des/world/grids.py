@@ -20,8 +20,9 @@ Cells = tuple[slice, slice]
 def summed(mask: BoolArray) -> np.ndarray:
     """Summed-area table of ``mask``, one row and column of zeros in front."""
     table = np.zeros((mask.shape[0] + 1, mask.shape[1] + 1), dtype=np.int32)
-    np.cumsum(mask, axis=0, dtype=np.int32, out=table[1:, 1:])
-    np.cumsum(table[1:, 1:], axis=1, out=table[1:, 1:])
+    table[1:, 1:] = mask  # accumulating int32 in place: twice as fast as cumsum from bool
+    np.add.accumulate(table, axis=0, out=table)
+    np.add.accumulate(table, axis=1, out=table)
     return table
 
 
@@ -116,4 +117,18 @@ def reachable(space: FreeSpace, taken: BoolArray, passage: float,
     from_door[labels[space.door & eroded]] = True
     from_door[0] = False
     return eroded, from_door[labels]
+
+
+
+def eroded_after(space: FreeSpace, taken: BoolArray, walk_eroded: BoolArray,
+                 taken_before: BoolArray, stamped: Cells, radius: float) -> BoolArray:
+    """The walkable floor eroded by ``radius`` cells once the cells ``stamped`` are taken
+    (``taken``: after, ``taken_before``: before; ``walk_eroded``: the erosion before): from
+    the erosion before, as the walk lost the whole rectangle (the usual case: a spot on the
+    room's free floor), or by eroding around it again."""
+    was = (space.free & ~taken_before)[stamped]
+    outside = (space.open_floor & ~space.inside)[stamped]
+    if (was & ~outside).all():
+        return erode_without(walk_eroded, radius, stamped)
+    return erode_near(walkable(space, taken), radius, stamped, walk_eroded)
 
