@@ -12,6 +12,7 @@ import math
 import numpy as np
 from scipy import ndimage
 
+from astralis_des.memo import kept
 from astralis_des.world.freespace import CROSS, BoolArray, FreeSpace
 
 Cells = tuple[slice, slice]
@@ -132,3 +133,21 @@ def eroded_after(space: FreeSpace, taken: BoolArray, walk_eroded: BoolArray,
         return erode_without(walk_eroded, radius, stamped)
     return erode_near(walkable(space, taken), radius, stamped, walk_eroded)
 
+
+def backs_onto_wall(space: FreeSpace, wall: int, kx: int, ky: int) -> BoolArray:
+    """Corners whose ``kx`` by ``ky`` window's back row or column lies wholly along the wall
+    on side ``wall`` (the room's own: kept on its free space, by wall and window)."""
+    kept_backs: dict[tuple[int, int, int], BoolArray] = kept(space, "wall_backs", 4096)
+    key = (wall, kx, ky)
+    if key not in kept_backs:
+        side = summed(space.wall_sides()[wall])
+        nx, ny = space.shape[0] - kx + 1, space.shape[1] - ky + 1
+        if wall in (0, 1):
+            start = 0 if wall == 0 else kx - 1
+            backs = window(side, 1, ky)[start:start + nx, :ny] == ky
+        else:
+            start = 0 if wall == 2 else ky - 1
+            backs = window(side, kx, 1)[:nx, start:start + ny] == kx
+        backs.setflags(write=False)
+        kept_backs[key] = backs
+    return kept_backs[key]
