@@ -32,7 +32,7 @@ CELL = 0.5  # m, floor cells for coverage
 CHUNK = 16  # looks judged at a time, in time order, until one detects
 BOUND_SHARE = 0.8  # of min_pixels the unhidden bound (sampled coarser) must reach
 PASSES = 6  # interleaved passes over a path's points when judging coverage
-FEW_PAIRS = 256  # pairs of point and cell judged without culling first
+FEW_PAIRS = 128  # pairs of point and cell judged without culling first
 MEMO_SWEEPS = 65536  # coverage answers a world keeps (16-byte digests of their inputs)
 __all__ = ["GeometricSensor", "Sighting", "in_frame"]
 
