@@ -8,6 +8,7 @@ whole grid again.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -137,10 +138,12 @@ def eroded_after(space: FreeSpace, taken: BoolArray, walk_eroded: BoolArray,
 def backs_onto_wall(space: FreeSpace, wall: int, kx: int, ky: int) -> BoolArray:
     """Corners whose ``kx`` by ``ky`` window's back row or column lies wholly along the wall
     on side ``wall`` (the room's own: kept on its free space, by wall and window)."""
-    kept_backs: dict[tuple[int, int, int], BoolArray] = kept(space, "wall_backs", 4096)
+    kept_backs: dict[object, Any] = kept(space, "wall_backs", 4096)
     key = (wall, kx, ky)
     if key not in kept_backs:
-        side = summed(space.wall_sides()[wall])
+        if "sides" not in kept_backs:  # the summed-area tables of the four walls' cells
+            kept_backs["sides"] = [summed(side) for side in space.wall_sides()]
+        side = kept_backs["sides"][wall]
         nx, ny = space.shape[0] - kx + 1, space.shape[1] - ky + 1
         if wall in (0, 1):
             start = 0 if wall == 0 else kx - 1
@@ -150,4 +153,5 @@ def backs_onto_wall(space: FreeSpace, wall: int, kx: int, ky: int) -> BoolArray:
             backs = window(side, kx, 1)[:nx, start:start + ny] == kx
         backs.setflags(write=False)
         kept_backs[key] = backs
-    return kept_backs[key]
+    out: BoolArray = kept_backs[key]
+    return out
