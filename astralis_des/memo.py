@@ -15,7 +15,8 @@ What is kept, on what (``kept(owner, NAME)``):
   sky), ``ducked`` (legs that duck under a lintel), and its router's Dijkstra rows
   (``world.routing``, its own cache, at most 256 MB);
 - on a **voxel map**: ``occupied_points`` (its occupied cells' centres);
-- on a room's **free space**: ``empty_reach`` (where a robot reaches in the empty room).
+- on a room's **free space**: ``empty_reach`` (where a robot reaches in the empty room) and
+  ``wall_backs`` (where a footprint's back lies along a wall, by wall and footprint).
 
 Elsewhere, once per process and by value (``functools``): the packaged clutter catalogue, the
 ROS 2 message types, a camera's swath by view and height, a catalogue without its furniture,
@@ -31,7 +32,7 @@ from __future__ import annotations
 from typing import Any
 
 NAMES = frozenset({"voxel_map", "block_field", "free_space", "furnished", "coverage",
-                   "first_pass", "sky", "ducked", "occupied_points", "empty_reach"})
+                   "first_pass", "sky", "ducked", "occupied_points", "empty_reach", "wall_backs"})
 
 
 def kept(owner: object, name: str, limit: int | None = None) -> dict[Any, Any]:

@@ -32,6 +32,7 @@ CELL = 0.5  # m, floor cells for coverage
 CHUNK = 16  # looks judged at a time, in time order, until one detects
 BOUND_SHARE = 0.8  # of min_pixels the unhidden bound (sampled coarser) must reach
 PASSES = 6  # interleaved passes over a path's points when judging coverage
+FEW_PAIRS = 128  # pairs of point and cell judged without culling first
 MEMO_SWEEPS = 65536  # coverage answers a world keeps (16-byte digests of their inputs)
 __all__ = ["GeometricSensor", "Sighting", "in_frame"]
 
@@ -149,6 +150,7 @@ class GeometricSensor:
         seen = np.zeros(len(cells), dtype=bool)
         lo, hi = np.asarray(room.box.lo), np.asarray(room.box.hi)
         in_room = np.all((pts >= lo) & (pts <= hi), axis=1)
+        later = np.zeros((len(pts), len(cells)), dtype=bool)  # the later passes' pairs
         for first in range(min(PASSES, len(pts))):
             rows, todo = np.arange(first, len(pts), PASSES), np.flatnonzero(~seen)
             if len(todo) == 0:
@@ -158,7 +160,12 @@ class GeometricSensor:
                 r, c = np.nonzero(shown)
                 pi, ci = rows[r], c
             else:
-                pi, ci = _shown(view, pts, axes, cells, size, rows, todo)
+                if first == 1:  # every later pass's points at once (the cells left after
+                    # the first pass): many small calls cost more than one on a few pairs
+                    after = np.flatnonzero(np.arange(len(pts)) % PASSES)
+                    later[_shown(view, pts, axes, cells, size, after, todo)] = True
+                r, c = np.nonzero(later[rows][:, todo])
+                pi, ci = rows[r], todo[c]
             if not len(boxes):
                 # An empty room is a convex box: from inside it every cell is in sight.
                 seen[ci[in_room[pi]]] = True
@@ -187,7 +194,12 @@ class GeometricSensor:
 def _shown(view: View, pts: FloatArray, axes: Axes, cells: FloatArray, size: FloatArray,
            rows: np.ndarray, todo: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The pairs (``rows`` x ``todo``) where a target on the cell would show enough pixels
-    from the point, if nothing hid it: culled against the frustum, the rest counted."""
+    from the point, if nothing hid it: culled against the frustum, the rest counted (a few
+    pairs are all counted: culling them would cost more than it saves)."""
+    if len(rows) * len(todo) <= FEW_PAIRS:
+        pi, ci = np.repeat(rows, len(todo)), np.tile(todo, len(rows))
+        big = shows_unhidden(view, pts, axes, cells, size, pi, ci)
+        return pi[big], ci[big]
     sure, maybe = cull(view, pts[rows], pick(axes, rows), cells[todo], size)
     pi, ci = rows[maybe[0]], todo[maybe[1]]
     big = shows_unhidden(view, pts, axes, cells, size, pi, ci)

@@ -296,3 +296,42 @@ def test_erosion_near_a_new_footprint_equals_eroding_the_whole_floor() -> None:
         after = walk.copy()
         after[changed] = False
         assert np.array_equal(erode_near(after, radius, changed, before), erode(after, radius))
+
+
+def test_summed_area_tables_count_the_cells_of_every_window() -> None:
+    """A summed-area table (accumulated in place) gives, for any window, the number of set
+    cells numpy counts in it."""
+    from astralis_des.world.grids import summed, window
+
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        mask = rng.random((int(rng.integers(1, 30)), int(rng.integers(1, 30)))) > 0.4
+        kx, ky = int(rng.integers(1, mask.shape[0] + 1)), int(rng.integers(1, mask.shape[1] + 1))
+        counts = window(summed(mask), kx, ky)
+        i, j = int(rng.integers(counts.shape[0])), int(rng.integers(counts.shape[1]))
+        assert counts[i, j] == mask[i:i + kx, j:j + ky].sum()
+        assert summed(mask)[-1, -1] == mask.sum()
+
+
+def test_cells_near_a_taken_one_kept_up_to_date_are_those_found_afresh(world: World) -> None:
+    """What a footprint's window must avoid (cells within its clearance of a taken one) is
+    kept up to date as footprints are stamped: at every step, on random rectangles (at the
+    room's edges too), the cells found afresh from what is taken."""
+    from astralis_des.world.clutter import Occupancy
+    from astralis_des.world.freespace import room_free_space
+
+    space = room_free_space(world, ROOMS[0])
+    rng = np.random.default_rng(9)
+    occupancy = Occupancy.empty(space, np.zeros(space.shape, dtype=bool), 0.7)
+    for grow in (0, 2, 3):
+        occupancy.near_taken(grow)
+    (x0, y0), (nx, ny) = space.origin[:2], space.shape
+    for _ in range(40):
+        lo = (x0 + rng.uniform(-0.5, nx * space.cell), y0 + rng.uniform(-0.5, ny * space.cell))
+        size = rng.uniform(0.05, 1.5, 2)
+        occupancy.stamp(space, Box((*lo, 0.0), (lo[0] + size[0], lo[1] + size[1], 0.0)), 0.2)
+        afresh = Occupancy.empty(space, occupancy.keepout, 0.7)
+        afresh.taken = occupancy.taken
+        for grow in (0, 2, 3):
+            assert np.array_equal(occupancy.near[grow], afresh.near_taken(grow))
+    assert occupancy.taken.any() and not occupancy.taken.all()

@@ -232,6 +232,33 @@ def test_coverage_judges_pairs_as_the_detection_model_does(kind: str) -> None:
     assert not expected[culled].any()  # culled: never one the model accepts
 
 
+@pytest.mark.parametrize("kind", ["uav", "ugv", "human"])
+def test_a_few_pairs_counted_without_culling_are_the_pairs_culling_finds(kind: str) -> None:
+    """A few pairs of point and cell are all counted, many are culled first: both ways give
+    the same pairs, on random eyes and cells."""
+    from astralis_des import sensing
+
+    rng = np.random.default_rng(11)
+    view, size = View.of_kind(kind), np.asarray(TARGET_SIZE)
+    eyes = np.column_stack([rng.uniform(-3, 3, (60, 2)), rng.uniform(0.3, 2.5, 60)])
+    cells = np.column_stack([rng.uniform(-6, 6, (400, 2)), np.full(400, 0.5)])
+    axes = view.axes(rng.uniform(-np.pi, np.pi, 60))
+    found = 0
+    for _ in range(40):
+        rows = np.sort(rng.choice(60, int(rng.integers(1, 20)), replace=False))
+        todo = np.sort(rng.choice(400, int(rng.integers(1, 40)), replace=False))
+        few = sensing._shown(view, eyes, axes, cells, size, rows, todo)
+        many = sensing.FEW_PAIRS
+        try:
+            sensing.FEW_PAIRS = 0
+            culled = sensing._shown(view, eyes, axes, cells, size, rows, todo)
+        finally:
+            sensing.FEW_PAIRS = many
+        assert set(zip(*few, strict=True)) == set(zip(*culled, strict=True))
+        found += len(few[0])
+    assert found > 0
+
+
 @pytest.mark.parametrize(("kind", "drop"), [("uav", 1.475), ("uav", 0.8), ("human", 1.1)])
 def test_swath_culls_nothing_the_pixel_count_would_see(kind: str, drop: float) -> None:
     """The swath skips the pixel count where the box is surely in or out of the frame: the

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -21,10 +21,9 @@ from astralis_des.world.catalogue import Catalogue, agree, avatar_size, default_
 from astralis_des.world.freespace import BoolArray, FreeSpace, room_free_space
 from astralis_des.world.geometry import Box
 from astralis_des.world.grids import (
-    Cells,
+    backs_onto_wall,
     erode,
-    erode_near,
-    erode_without,
+    eroded_after,
     padded,
     reachable,
     summed,
@@ -82,6 +81,9 @@ class Occupancy:
     keepout: BoolArray  # cells kept empty (in front of the door)
     reach: BoolArray  # free cells a robot's centre can reach from the door
     walk_eroded: BoolArray  # where the centre of a robot as wide as the passage fits
+    # by a clearance in cells: the cells within it of a taken one, kept up to date as
+    # footprints are stamped (what a footprint's window must not hold)
+    near: dict[int, BoolArray] = field(default_factory=dict)
 
     @classmethod
     def empty(cls, space: FreeSpace, keepout: BoolArray, passage: float) -> Occupancy:
@@ -99,8 +101,28 @@ class Occupancy:
         """Reachability again after footprints were stamped by hand."""
         self.reach, self.walk_eroded = _reach(space, self.taken, passage)
 
+    def near_taken(self, grow: int) -> BoolArray:
+        """Cells within ``grow`` cells (a square) of a taken one."""
+        if grow not in self.near:
+            table = summed(padded(self.taken, grow, False))
+            self.near[grow] = window(table, 2 * grow + 1, 2 * grow + 1) > 0
+        return self.near[grow]
+
+    def saved(self) -> Occupancy:
+        """A copy to :meth:`restore` (a footprint tried and given up)."""
+        return replace(self, taken=self.taken.copy(), halo=self.halo.copy(),
+                       near={g: a.copy() for g, a in self.near.items()})
+
+    def restore(self, saved: Occupancy) -> None:
+        self.taken, self.halo, self.near = saved.taken, saved.halo, saved.near
+
     def stamp(self, space: FreeSpace, box: Box, clearance: float) -> None:
-        self.taken[space.cells(box.lo, box.hi)] = True
+        rows, cols = space.cells(box.lo, box.hi)
+        self.taken[rows, cols] = True
+        (i0, i1), (j0, j1) = (rows.start, rows.stop), (cols.start, cols.stop)
+        if i0 < i1 and j0 < j1:  # taken is the union of the stamped rectangles
+            for g, near in self.near.items():
+                near[max(i0 - g, 0):i1 + g, max(j0 - g, 0):j1 + g] = True
         grow = (clearance, clearance, 0.0)
         lo = tuple(a - g for a, g in zip(box.lo, grow, strict=True))
         hi = tuple(a + g for a, g in zip(box.hi, grow, strict=True))
@@ -254,29 +276,16 @@ def place_in(space: FreeSpace, occupied: Occupancy, footprint: Sequence[float],
         offset = int(pick - (bounds[which - 1] if which else 0))
         spot = layout.spot(space, np.divmod(corners[offset], width))
         box = _footprint_box(spot)
-        before = (occupied.taken.copy(), occupied.halo.copy())
+        before = occupied.saved()
         occupied.stamp(space, box, clearance)
-        walk_eroded = _eroded_after(space, occupied, before[0], space.cells(box.lo, box.hi),
-                                    passage / 2 / space.cell)
+        walk_eroded = eroded_after(space, occupied.taken, occupied.walk_eroded, before.taken,
+                                   space.cells(box.lo, box.hi), passage / 2 / space.cell)
         eroded, reach = reachable(space, occupied.taken, passage, walk_eroded)
         if not (eroded & occupied.reach & ~reach).any():
             occupied.reach, occupied.walk_eroded = reach, walk_eroded
             return spot
-        occupied.taken, occupied.halo = before
+        occupied.restore(before)
     return "every spot tried cuts off free floor from the door"
-
-
-def _eroded_after(space: FreeSpace, occupied: Occupancy, taken_before: BoolArray,
-                  stamped: Cells, radius: float) -> BoolArray:
-    """The walkable floor eroded by ``radius`` cells once the cells ``stamped`` are taken:
-    from the erosion before, as the walk lost the whole rectangle (the usual case: a spot on
-    the room's free floor), or by eroding around it again."""
-    was = (space.free & ~taken_before)[stamped]
-    outside = (space.open_floor & ~space.inside)[stamped]
-    lost = was & ~outside
-    if lost.all():
-        return erode_without(occupied.walk_eroded, radius, stamped)
-    return erode_near(walkable(space, occupied.taken), radius, stamped, occupied.walk_eroded)
 
 
 @dataclass(frozen=True)
@@ -317,32 +326,23 @@ def _candidates(space: FreeSpace, occupied: Occupancy, w: float, d: float, again
                 clearance: float, turn: bool) -> list[tuple[_Layout, np.ndarray, int]]:
     """Each layout with the lower corner cells where it fits (flat indices into a grid of
     the width given with them)."""
+    # a window fits where all its cells are allowed and none is within the clearance of a
+    # taken one (the window grown by the clearance holds no taken cell): one table for both
     allowed = space.free & ~occupied.keepout & ~occupied.halo
-    grow = math.ceil(clearance / space.cell - 1e-6)
-    taken = padded(occupied.taken, grow, False)
-    allowed_table, taken_table = summed(allowed), summed(taken)
-    sides = _wall_tables(space) if against_wall else None
+    allowed &= ~occupied.near_taken(math.ceil(clearance / space.cell - 1e-6))
+    allowed_table = summed(allowed)
     found = []
     for layout in _layouts(w, d, space.cell, against_wall, turn):
         kx, ky = layout.cells
         fits = window(allowed_table, kx, ky) == kx * ky
         if fits.size == 0:
             continue
-        fits &= window(taken_table, kx + 2 * grow, ky + 2 * grow) == 0
-        if sides is not None:
-            fits &= _backs_onto_wall(sides[layout.wall], layout.wall, kx, ky, fits.shape)
+        if against_wall:
+            fits &= backs_onto_wall(space, layout.wall, kx, ky)
         corners = np.flatnonzero(fits)  # in the order of np.argwhere, as flat indices
         if len(corners):
             found.append((layout, corners, fits.shape[1]))
     return found
-
-
-def _wall_tables(space: FreeSpace) -> list[np.ndarray]:
-    """Summed-area tables of the cells along a wall towards -x, +x, -y, +y (once a room)."""
-    if "_wall_tables" not in space.__dict__:
-        space.__dict__["_wall_tables"] = [summed(side) for side in space.wall_sides()]
-    kept: list[np.ndarray] = space.__dict__["_wall_tables"]
-    return kept
 
 
 def _reach(space: FreeSpace, taken: BoolArray, passage: float) -> tuple[BoolArray, BoolArray]:
@@ -350,20 +350,6 @@ def _reach(space: FreeSpace, taken: BoolArray, passage: float) -> tuple[BoolArra
     (what placing the next footprint updates around it)."""
     walk_eroded = erode(walkable(space, taken), passage / 2 / space.cell)
     return reachable(space, taken, passage, walk_eroded)[1], walk_eroded
-
-
-def _backs_onto_wall(side: np.ndarray, wall: int, kx: int, ky: int,
-                     shape: tuple[int, ...]) -> np.ndarray:
-    """Corners whose window's back row or column lies wholly along a wall on that side
-    (``side``: the summed-area table of the cells along that wall)."""
-    nx, ny = shape
-    if wall in (0, 1):
-        column = window(side, 1, ky)
-        start = 0 if wall == 0 else kx - 1
-        return np.asarray(column[start:start + nx, :ny] == ky)
-    row = window(side, kx, 1)
-    start = 0 if wall == 2 else ky - 1
-    return np.asarray(row[:nx, start:start + ny] == kx)
 
 
 def _footprint_box(spot: Spot) -> Box:

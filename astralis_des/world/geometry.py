@@ -59,11 +59,13 @@ def segments_hit_boxes(p0: FloatArray, p1: FloatArray, boxes: FloatArray) -> NDA
     if len(candidates) == 0:
         return np.zeros(len(p0), dtype=bool)
     d = p1 - p0
-    enter, leave = _slab(p0[:, 0:1], d[:, 0], candidates[None, :, 0, 0], candidates[None, :, 1, 0])
-    for k in (1, 2):  # one axis at a time: (M, K) arrays, not (M, K, 3)
-        t_near, t_far = _slab(p0[:, k:k + 1], d[:, k], candidates[None, :, 0, k],
-                              candidates[None, :, 1, k])
-        enter, leave = np.maximum(enter, t_near), np.minimum(leave, t_far)
+    with np.errstate(divide="ignore", invalid="ignore"):  # once, not once an axis
+        enter, leave = _slab(p0[:, 0:1], d[:, 0], candidates[None, :, 0, 0],
+                             candidates[None, :, 1, 0])
+        for k in (1, 2):  # one axis at a time: (M, K) arrays, not (M, K, 3)
+            t_near, t_far = _slab(p0[:, k:k + 1], d[:, k], candidates[None, :, 0, k],
+                                  candidates[None, :, 1, k])
+            enter, leave = np.maximum(enter, t_near), np.minimum(leave, t_far)
     hit = (enter <= leave) & (leave >= 0.0) & (enter <= 1.0)
     return np.asarray(hit.any(axis=1))
 
@@ -71,12 +73,14 @@ def segments_hit_boxes(p0: FloatArray, p1: FloatArray, boxes: FloatArray) -> NDA
 def _slab(origin: FloatArray, d: FloatArray, lo: FloatArray,
           hi: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Where segments (``origin`` ``(M, 1)``, direction ``d`` ``(M,)``) enter and leave the
-    slabs ``lo..hi`` (``(1, K)``) of one axis, in units of the segment."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = (1.0 / d)[:, None]
-        t_a = (lo - origin) * inv
-        t_b = (hi - origin) * inv
+    slabs ``lo..hi`` (``(1, K)``) of one axis, in units of the segment (under the caller's
+    ``np.errstate``: a zero component divides by zero)."""
+    inv = (1.0 / d)[:, None]
+    t_a = (lo - origin) * inv
+    t_b = (hi - origin) * inv
     t_near, t_far = np.minimum(t_a, t_b), np.maximum(t_a, t_b)
+    if np.isfinite(inv).all():  # then no product is NaN and no component is zero
+        return t_near, t_far
     nan_a, nan_b = np.isnan(t_a), np.isnan(t_b)
     if nan_a.any():
         t_near[nan_a] = -np.inf

@@ -8,10 +8,12 @@ whole grid again.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
 
+from astralis_des.memo import kept
 from astralis_des.world.freespace import CROSS, BoolArray, FreeSpace
 
 Cells = tuple[slice, slice]
@@ -20,8 +22,9 @@ Cells = tuple[slice, slice]
 def summed(mask: BoolArray) -> np.ndarray:
     """Summed-area table of ``mask``, one row and column of zeros in front."""
     table = np.zeros((mask.shape[0] + 1, mask.shape[1] + 1), dtype=np.int32)
-    np.cumsum(mask, axis=0, dtype=np.int32, out=table[1:, 1:])
-    np.cumsum(table[1:, 1:], axis=1, out=table[1:, 1:])
+    table[1:, 1:] = mask  # accumulating int32 in place: twice as fast as cumsum from bool
+    np.add.accumulate(table, axis=0, out=table)
+    np.add.accumulate(table, axis=1, out=table)
     return table
 
 
@@ -117,3 +120,38 @@ def reachable(space: FreeSpace, taken: BoolArray, passage: float,
     from_door[0] = False
     return eroded, from_door[labels]
 
+
+
+def eroded_after(space: FreeSpace, taken: BoolArray, walk_eroded: BoolArray,
+                 taken_before: BoolArray, stamped: Cells, radius: float) -> BoolArray:
+    """The walkable floor eroded by ``radius`` cells once the cells ``stamped`` are taken
+    (``taken``: after, ``taken_before``: before; ``walk_eroded``: the erosion before): from
+    the erosion before, as the walk lost the whole rectangle (the usual case: a spot on the
+    room's free floor), or by eroding around it again."""
+    was = (space.free & ~taken_before)[stamped]
+    outside = (space.open_floor & ~space.inside)[stamped]
+    if (was & ~outside).all():
+        return erode_without(walk_eroded, radius, stamped)
+    return erode_near(walkable(space, taken), radius, stamped, walk_eroded)
+
+
+def backs_onto_wall(space: FreeSpace, wall: int, kx: int, ky: int) -> BoolArray:
+    """Corners whose ``kx`` by ``ky`` window's back row or column lies wholly along the wall
+    on side ``wall`` (the room's own: kept on its free space, by wall and window)."""
+    kept_backs: dict[object, Any] = kept(space, "wall_backs", 4096)
+    key = (wall, kx, ky)
+    if key not in kept_backs:
+        if "sides" not in kept_backs:  # the summed-area tables of the four walls' cells
+            kept_backs["sides"] = [summed(side) for side in space.wall_sides()]
+        side = kept_backs["sides"][wall]
+        nx, ny = space.shape[0] - kx + 1, space.shape[1] - ky + 1
+        if wall in (0, 1):
+            start = 0 if wall == 0 else kx - 1
+            backs = window(side, 1, ky)[start:start + nx, :ny] == ky
+        else:
+            start = 0 if wall == 2 else ky - 1
+            backs = window(side, kx, 1)[:nx, start:start + ny] == kx
+        backs.setflags(write=False)
+        kept_backs[key] = backs
+    out: BoolArray = kept_backs[key]
+    return out
