@@ -2,9 +2,8 @@
 stairwells, entrances and outdoor corners, one per agent kind, searched from a node when a
 route first leaves it (Dijkstra), its distances and predecessors kept for the next route.
 
-An all-pairs matrix (issue 38) cost 0.5 GB at 1,000 rooms and 9.5 GB a kind at 10,000; the
-rows of the nodes routes leave from are what is used, and each is the same row (scipy's
-Dijkstra from that node), so the routes are the same point for point.
+An all-pairs matrix (issue 38) cost 0.5 GB at 1,000 rooms, 9.5 GB a kind at 10,000; only
+the rows routes leave from are searched (the same rows), so routes are the same.
 """
 
 from __future__ import annotations
@@ -36,6 +35,7 @@ SNAP = 0.5  # m: a point this close to a room or corridor (in a wall, by a door)
 NOT_BLOCKERS = ("wall", "slab", BLOCK)
 CACHE_BYTES = 256_000_000  # of searched rows kept (12 B a node each): every row of a world of
 # 1,000 rooms, 600 of one of 10,000
+ROUTES_KEPT = 8192  # routes kept (a few waypoints each)
 
 
 class Site(Protocol):
@@ -86,6 +86,7 @@ class Router:
         self._graphs = {kind: self._graph(kind) for kind in KINDS}
         self._rows: OrderedDict[tuple[str, int], tuple[FloatArray, np.ndarray]] = OrderedDict()
         self._row_limit = max(16, CACHE_BYTES // (12 * max(len(self.names), 1)))
+        self._routes: OrderedDict[tuple[object, ...], FloatArray | None] = OrderedDict()
 
     def _graph(self, kind: str) -> csr_matrix:
         rows: list[int] = []
@@ -364,9 +365,21 @@ class Router:
 
     def route(self, start: FloatArray | tuple[float, ...], goal: FloatArray | tuple[float, ...],
               kind: str) -> FloatArray | None:
-        """Waypoints from ``start`` to ``goal`` at floor level, or ``None`` if unreachable."""
-        p = np.asarray(start, dtype=float)
-        q = np.asarray(goal, dtype=float)
+        """Waypoints from ``start`` to ``goal`` at floor level, or ``None`` if unreachable;
+        read-only, kept per ends and kind (the world does not change), up to ``ROUTES_KEPT``."""
+        p, q = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+        key = (kind, p.shape, p.tobytes(), q.shape, q.tobytes())
+        if key not in self._routes:
+            way = self._route(p, q, kind)
+            if way is not None:
+                way.flags.writeable = False
+            self._routes[key] = way
+            if len(self._routes) > ROUTES_KEPT:
+                self._routes.popitem(last=False)
+        self._routes.move_to_end(key)
+        return self._routes[key]
+
+    def _route(self, p: FloatArray, q: FloatArray, kind: str) -> FloatArray | None:
         p_place, q_place = self.place_of(p), self.place_of(q)
         if p_place == q_place and (p_place != "outdoor" or self._outdoor_clear(
                 p[None, :], q[None, :])[0]) and (p_place not in self._outlines or visible(
