@@ -54,3 +54,19 @@ def test_poses_are_numpy_interpolation_bit_for_bit() -> None:
             expected = [np.interp(s, motion.cum, points[:, k]) for k in range(3)]
             assert motion.at(float(t)).tolist() == expected
             assert motion.travelled(float(t)) == s
+
+
+def test_what_is_derived_from_a_course_is_kept_by_key() -> None:
+    """A value derived from a course is made once per key and shared by motions on it; another
+    key (the camera's heading before the start) is made anew."""
+    made: list[float] = []
+
+    def make(heading: float) -> float:
+        made.append(heading)
+        return heading * 2
+
+    first, second = Motion(PATH.copy(), 2.0), Motion(PATH.copy(), 2.0)
+    assert first.derived(("x", 0.5), lambda: make(0.5)) == 1.0
+    assert second.derived(("x", 0.5), lambda: make(0.5)) == 1.0
+    assert second.derived(("x", 0.7), lambda: make(0.7)) == 1.4
+    assert made == [0.5, 0.7]

@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import math
 from bisect import bisect_right
+from collections.abc import Callable, Hashable
 from functools import lru_cache
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -16,6 +18,8 @@ from astralis_des.kernel.profile import Profile, build
 from astralis_des.world.geometry import FloatArray
 
 KEPT = 4096  # courses a process keeps (the least recently used dropped)
+DERIVED = 8  # values derived from a course (by key) that it keeps
+T = TypeVar("T")
 
 
 class Course:
@@ -33,6 +37,17 @@ class Course:
         self._axes: list[list[float]] = points.T.tolist()
         self._times: FloatArray | None = None
         self._legs: tuple[list[float], list[int], list[float]] | None = None
+        self._derived: dict[Hashable, Any] = {}
+
+    def derived(self, key: Hashable, make: Callable[[], T]) -> T:
+        """What ``make`` derives from the course alone and ``key`` (sensing samples along
+        it), made once: the last ``DERIVED`` keys kept."""
+        if key not in self._derived:
+            if len(self._derived) >= DERIVED:
+                del self._derived[next(iter(self._derived))]
+            self._derived[key] = make()
+        value: T = self._derived[key]
+        return value
 
     def point(self, s: float) -> list[float]:
         """The point at arc length ``s``: ``np.interp`` on each axis, bit for bit."""

@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
 
 from astralis_des.kernel.course import Course, course_of
 from astralis_des.kernel.profile import Profile
 from astralis_des.world.geometry import FloatArray
+
+T = TypeVar("T")
 
 if TYPE_CHECKING:
     from astralis_des.kernel.handler import TaskHandler
@@ -100,6 +103,11 @@ class Motion:
         horizontally (the turned-to heading for a robot that turns on the spot)."""
         return self._course.heading_at(self.profile.arc_at(t - self.t0), before,
                                        self.turn_rate is not None)
+
+    def derived(self, key: Hashable, make: Callable[[], T]) -> T:
+        """What ``make`` derives from the path and the parameters alone (and ``key``): made
+        once for every motion along the same course (:class:`.course.Course`)."""
+        return self._course.derived(key, make)
 
     def vertices_until(self, t: float) -> tuple[FloatArray, FloatArray]:
         """Timed vertices passed by time ``t``, plus the pose at ``t``: ``(times, points)``."""
