@@ -114,6 +114,13 @@ def test_a_kept_route_is_keyed_on_both_ends_and_the_kind(world: World) -> None:
         assert again is not None and not np.array_equal(again, first)
         assert np.array_equal(again, fresh._route(np.asarray(ends[0], dtype=float),
                                                   np.asarray(ends[1], dtype=float), kind))
+    room = world.rooms["A.1.1.1"]
+    assert [world.router.place_of(p) for p in (start, room.center, start)] == [
+        "outdoor", "A.1.1.1", "outdoor"]
+    with pytest.raises(InputError):  # refused each time it is asked, never kept
+        world.router.place_of((-5.0, 10.0, 0.0))
+    with pytest.raises(InputError):
+        world.router.place_of((-5.0, 10.0, 0.0))
 
 
 def test_points_inside_walls_or_outside_the_site_are_refused(world: World) -> None:

@@ -22,6 +22,7 @@ from astralis_des.errors import InputError
 from astralis_des.kinds import KIND_DEFAULTS, KINDS, KindDefaults
 from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
 from astralis_des.world.interior_routes import reflex_corners, side_of, visible
+from astralis_des.world.kept import Kept
 from astralis_des.world.parts import BLOCK, Building, InteriorPlan, Room, Solid, Space
 
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
@@ -35,7 +36,7 @@ SNAP = 0.5  # m: a point this close to a room or corridor (in a wall, by a door)
 NOT_BLOCKERS = ("wall", "slab", BLOCK)
 CACHE_BYTES = 256_000_000  # of searched rows kept (12 B a node each): every row of a world of
 # 1,000 rooms, 600 of one of 10,000
-ROUTES_KEPT = 8192  # routes kept (a few waypoints each)
+ROUTES_KEPT = 8192  # routes kept (a few waypoints each), and places of points
 
 
 class Site(Protocol):
@@ -86,7 +87,8 @@ class Router:
         self._graphs = {kind: self._graph(kind) for kind in KINDS}
         self._rows: OrderedDict[tuple[str, int], tuple[FloatArray, np.ndarray]] = OrderedDict()
         self._row_limit = max(16, CACHE_BYTES // (12 * max(len(self.names), 1)))
-        self._routes: OrderedDict[tuple[object, ...], FloatArray | None] = OrderedDict()
+        self._routes: Kept[FloatArray | None] = Kept(ROUTES_KEPT)
+        self._places: Kept[str] = Kept(ROUTES_KEPT)
 
     def _graph(self, kind: str) -> csr_matrix:
         rows: list[int] = []
@@ -285,8 +287,12 @@ class Router:
 
     # -- queries --------------------------------------------------------------------------
     def place_of(self, point: FloatArray | tuple[float, ...]) -> str:
-        """Name of the convex place holding ``point``: a room id, a space id or ``outdoor``."""
+        """Name of the convex place holding ``point``: a room id, a space id or ``outdoor``
+        (kept per point; a point in a wall or off the site is an ``InputError``)."""
         p = np.asarray(point, dtype=float)
+        return self._places.get((p.shape, p.tobytes()), lambda: self._place_of(p))
+
+    def _place_of(self, p: FloatArray) -> str:
         room = self.world.room_at(p)
         if room is not None:
             return room.id
@@ -368,16 +374,8 @@ class Router:
         """Waypoints from ``start`` to ``goal`` at floor level, or ``None`` if unreachable;
         read-only, kept per ends and kind (the world does not change), up to ``ROUTES_KEPT``."""
         p, q = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
-        key = (kind, p.shape, p.tobytes(), q.shape, q.tobytes())
-        if key not in self._routes:
-            way = self._route(p, q, kind)
-            if way is not None:
-                way.flags.writeable = False
-            self._routes[key] = way
-            if len(self._routes) > ROUTES_KEPT:
-                self._routes.popitem(last=False)
-        self._routes.move_to_end(key)
-        return self._routes[key]
+        return self._routes.get((kind, p.shape, p.tobytes(), q.shape, q.tobytes()),
+                                lambda: _read_only(self._route(p, q, kind)))
 
     def _route(self, p: FloatArray, q: FloatArray, kind: str) -> FloatArray | None:
         p_place, q_place = self.place_of(p), self.place_of(q)
@@ -400,6 +398,12 @@ class Router:
         while nodes[-1] != a[i]:
             nodes.append(int(pred[i][nodes[-1]]))
         return np.vstack([p, self.positions[nodes[::-1]], q])
+
+
+def _read_only(way: FloatArray | None) -> FloatArray | None:
+    if way is not None:
+        way.flags.writeable = False
+    return way
 
 
 def _by_stairs(kind: KindDefaults, building: Building) -> bool:
