@@ -49,9 +49,8 @@ class GeometricSensor:
     def first_sighting(self, robot: Robot, motion: Motion) -> Sighting | None:
         if robot.view is None:
             return None
-        pts, s = resample(motion.points, SAMPLE_STEP)
-        headings = travel_headings(pts, robot.heading)
-        times = motion.time_of(s)
+        pts, headings, times = motion.derived(("sightings", SAMPLE_STEP, robot.heading),
+                                              lambda: _samples(motion, robot.heading))
         return self._first(robot, pts, headings, times,
                            self.target.positions_at(motion.t0 + times))
 
@@ -258,6 +257,16 @@ def floor_cells(room: Room) -> FloatArray:
     ys = np.arange(lo[1] + CELL / 2, hi[1], CELL)
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
     return np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, lo[2] + TARGET_HEIGHT)])
+
+
+def _samples(motion: Motion, heading: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Points every ``SAMPLE_STEP`` along a motion, the camera's heading at each (from
+    ``heading``) and when it is there (after the start): read-only, kept with the motion."""
+    pts, s = resample(motion.points, SAMPLE_STEP)
+    out = (pts, travel_headings(pts, heading), np.asarray(motion.time_of(s)))
+    for part in out:
+        part.flags.writeable = False
+    return out
 
 
 def _xyz(p: FloatArray) -> tuple[float, float, float]:

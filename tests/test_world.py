@@ -11,6 +11,7 @@ import pytest
 from astralis_des.errors import InputError
 from astralis_des.world.build import load_world
 from astralis_des.world.model import World
+from astralis_des.world.routing import Router
 
 
 def test_site_is_about_38000_square_metres(world: World) -> None:
@@ -97,6 +98,29 @@ def test_routes_upstairs_climb_the_stairwell(world: World) -> None:
     assert not any(shaft.contains((*xy, 1.0), 0.5) for xy in uav_xy)
     walker_xy = walk[climbing(walk)][:, :2]  # type: ignore[index]
     assert np.linalg.norm(uav_xy[:, None] - walker_xy[None], axis=2).min() > 2.0
+
+
+def test_a_kept_route_is_keyed_on_both_ends_and_the_kind(world: World) -> None:
+    """Asked again, a route is the kept one (read-only); a moved start, another goal or another
+    kind is routed anew, as a fresh router routes it."""
+    start, goal = (20.0, 20.0, 0.0), world.rooms["A.3.1.2"].center
+    first = world.router.route(start, goal, "human")
+    assert first is not None and world.router.route(start, goal, "human") is first
+    assert not first.flags.writeable
+    fresh = Router(world)
+    for ends, kind in ((((21.0, 20.0, 0.0), goal), "human"), ((start, goal), "uav"),
+                       ((start, world.rooms["A.1.1.1"].center), "human")):
+        again = world.router.route(*ends, kind)
+        assert again is not None and not np.array_equal(again, first)
+        assert np.array_equal(again, fresh._route(np.asarray(ends[0], dtype=float),
+                                                  np.asarray(ends[1], dtype=float), kind))
+    room = world.rooms["A.1.1.1"]
+    assert [world.router.place_of(p) for p in (start, room.center, start)] == [
+        "outdoor", "A.1.1.1", "outdoor"]
+    with pytest.raises(InputError):  # refused each time it is asked, never kept
+        world.router.place_of((-5.0, 10.0, 0.0))
+    with pytest.raises(InputError):
+        world.router.place_of((-5.0, 10.0, 0.0))
 
 
 def test_points_inside_walls_or_outside_the_site_are_refused(world: World) -> None:

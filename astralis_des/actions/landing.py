@@ -138,13 +138,15 @@ def _free(boxes: FloatArray, spots: FloatArray, floor: float) -> np.ndarray:
         return np.zeros(0, dtype=bool)
     lo = np.column_stack([spots[:, :2] - LANDING_CLEAR, np.full(len(spots), floor + 0.02)])
     hi = np.column_stack([spots[:, :2] + LANDING_CLEAR, spots[:, 2]])
-    near = np.all((boxes[:, 0] < hi.max(axis=0)) & (boxes[:, 1] > lo.min(axis=0)), axis=1)
-    boxes = boxes[near]
+    boxes = boxes[np.all((boxes[:, 0] < hi.max(axis=0)) & (boxes[:, 1] > lo.min(axis=0)),
+                         axis=1)]
     ok = np.ones(len(spots), dtype=bool)
-    for start in range(0, len(spots), 512):  # in blocks: spots x boxes x 3 stays small
-        a, b = lo[start:start + 512], hi[start:start + 512]
-        hit = np.all((boxes[None, :, 0] < b[:, None]) & (boxes[None, :, 1] > a[:, None]), axis=2)
-        ok[start:start + 512] = ~hit.any(axis=1)
+    for start in range(0, len(spots), 128):  # in blocks of nearby spots (a grid's, a ring's),
+        a, b = lo[start:start + 128], hi[start:start + 128]  # each against the boxes near it
+        near = boxes[np.all((boxes[:, 0] < b.max(axis=0)) & (boxes[:, 1] > a.min(axis=0)),
+                            axis=1)]
+        hit = np.all((near[None, :, 0] < b[:, None]) & (near[None, :, 1] > a[:, None]), axis=2)
+        ok[start:start + 128] = ~hit.any(axis=1)
     return ok
 
 

@@ -9,7 +9,8 @@ interpolates it, the physics one flies or drives it as a reference.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from bisect import bisect_right
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -29,6 +30,19 @@ class Profile:
     a: FloatArray  # phase accelerations
     duration: float
     headings: FloatArray  # heading of each leg (for turning robots)
+    _phases: tuple[list[float], ...] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:  # plain floats for one time at a time (:meth:`arc_at`)
+        object.__setattr__(self, "_phases", (self.t.tolist(), self.s.tolist(),
+                                             self.v.tolist(), self.a.tolist()))
+
+    def arc_at(self, t: float) -> float:
+        """:meth:`arc` at one time, in plain floats (the same arithmetic, bit for bit)."""
+        times, s, v, a = self._phases
+        tt = min(max(t, 0.0), self.duration)
+        i = min(max(bisect_right(times, tt) - 1, 0), len(times) - 1)
+        dt = tt - times[i]
+        return s[i] + v[i] * dt + 0.5 * a[i] * dt * dt
 
     def arc(self, t: float | FloatArray) -> FloatArray:
         """Arc length reached at time ``t`` (clamped to the profile)."""

@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
 
-from astralis_des.kernel.profile import Profile, build
+from astralis_des.kernel.course import Course, course_of
+from astralis_des.kernel.profile import Profile
 from astralis_des.world.geometry import FloatArray
+
+T = TypeVar("T")
 
 if TYPE_CHECKING:
     from astralis_des.kernel.handler import TaskHandler
@@ -43,13 +47,14 @@ class Motion:
     heading: float = 0.0
     cum: FloatArray = field(init=False)
     profile: Profile = field(init=False)
+    _course: Course = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         self.points = np.asarray(self.points, dtype=float)
-        seg = np.linalg.norm(np.diff(self.points, axis=0), axis=1) if len(self.points) > 1 \
-            else np.zeros(0)
-        self.cum = np.concatenate([[0.0], np.cumsum(seg)])
-        self.profile = build(self.points, self.speed, self.accel, self.turn_rate, self.heading)
+        self._course = course_of(self.points, self.speed, self.accel, self.turn_rate,
+                                 self.heading)
+        self.cum = self._course.cum
+        self.profile = self._course.profile
 
     @property
     def length(self) -> float:
@@ -60,10 +65,10 @@ class Motion:
         return self.profile.duration
 
     def _point(self, s: float) -> FloatArray:
-        return np.array([np.interp(s, self.cum, self.points[:, k]) for k in range(3)])
+        return np.array(self._course.point(s))
 
     def at(self, t: float) -> FloatArray:
-        return self._point(float(self.profile.arc(t - self.t0)))
+        return self._point(self.profile.arc_at(t - self.t0))
 
     def velocity(self, t: float) -> FloatArray:
         """The reference velocity at ``t``: the profile's speed along the current leg."""
@@ -87,7 +92,7 @@ class Motion:
         return pos, unit[k] * self.profile.speeds(dt)[:, None]
 
     def travelled(self, t: float) -> float:
-        return float(self.profile.arc(t - self.t0))
+        return self.profile.arc_at(t - self.t0)
 
     def time_of(self, s: FloatArray) -> FloatArray:
         """Seconds after the start at which each arc length in ``s`` is reached."""
@@ -96,22 +101,17 @@ class Motion:
     def heading_at(self, t: float, before: float) -> float:
         """The heading after running until ``t``: that of the last leg begun that moves
         horizontally (the turned-to heading for a robot that turns on the spot)."""
-        s = float(self.profile.arc(t - self.t0))
-        legs = np.flatnonzero(np.diff(self.cum) > 1e-9)
-        begun = legs[self.cum[legs] <= s + 1e-9]
-        steps = np.diff(self.points, axis=0)[begun]
-        flat = np.flatnonzero(np.hypot(steps[:, 0], steps[:, 1]) > 1e-6)
-        if not len(flat):
-            return before
-        headings = self.profile.headings
-        if self.turn_rate is not None and len(headings):
-            return float(headings[flat[-1]])
-        dx, dy = steps[flat[-1], :2]
-        return float(np.arctan2(dy, dx))
+        return self._course.heading_at(self.profile.arc_at(t - self.t0), before,
+                                       self.turn_rate is not None)
+
+    def derived(self, key: Hashable, make: Callable[[], T]) -> T:
+        """What ``make`` derives from the path and the parameters alone (and ``key``): made
+        once for every motion along the same course (:class:`.course.Course`)."""
+        return self._course.derived(key, make)
 
     def vertices_until(self, t: float) -> tuple[FloatArray, FloatArray]:
         """Timed vertices passed by time ``t``, plus the pose at ``t``: ``(times, points)``."""
-        times = self.t0 + self.profile.time_of(self.cum)
+        times = self.t0 + self._course.vertex_times()
         keep = times < t
         pts = np.vstack([self.points[keep], self.at(t)[None, :]])
         return np.append(times[keep], t), pts

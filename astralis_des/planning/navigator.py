@@ -244,9 +244,9 @@ class Navigator(Lintels):
         """Boxes of still furniture and avatars in the rooms overlapping ``[lo, hi]``: those
         rooms are furnished first (a plan past a room sees its furniture, whether or not
         anyone has looked in yet)."""
-        rooms = [rid for rid, room in self.world.rooms.items()
-                 if np.all(np.asarray(room.box.lo) <= hi) and
-                 np.all(np.asarray(room.box.hi) >= lo)]
+        boxes, ids = self.world.room_boxes, self.world.room_ids
+        rooms = [ids[k] for k in np.flatnonzero(np.all((boxes[:, 0] <= hi) &
+                                                       (boxes[:, 1] >= lo), axis=1))]
         self.scene.furnish(rooms)
         return self.scene.still_boxes(rooms)
 

@@ -2,9 +2,8 @@
 stairwells, entrances and outdoor corners, one per agent kind, searched from a node when a
 route first leaves it (Dijkstra), its distances and predecessors kept for the next route.
 
-An all-pairs matrix (issue 38) cost 0.5 GB at 1,000 rooms and 9.5 GB a kind at 10,000; the
-rows of the nodes routes leave from are what is used, and each is the same row (scipy's
-Dijkstra from that node), so the routes are the same point for point.
+An all-pairs matrix (issue 38) cost 0.5 GB at 1,000 rooms, 9.5 GB a kind at 10,000; only
+the rows routes leave from are searched (the same rows), so routes are the same.
 """
 
 from __future__ import annotations
@@ -23,6 +22,7 @@ from astralis_des.errors import InputError
 from astralis_des.kinds import KIND_DEFAULTS, KINDS, KindDefaults
 from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
 from astralis_des.world.interior_routes import reflex_corners, side_of, visible
+from astralis_des.world.kept import Kept
 from astralis_des.world.parts import BLOCK, Building, InteriorPlan, Room, Solid, Space
 
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
@@ -36,6 +36,7 @@ SNAP = 0.5  # m: a point this close to a room or corridor (in a wall, by a door)
 NOT_BLOCKERS = ("wall", "slab", BLOCK)
 CACHE_BYTES = 256_000_000  # of searched rows kept (12 B a node each): every row of a world of
 # 1,000 rooms, 600 of one of 10,000
+ROUTES_KEPT = 8192  # routes kept (a few waypoints each), and places of points
 
 
 class Site(Protocol):
@@ -86,6 +87,8 @@ class Router:
         self._graphs = {kind: self._graph(kind) for kind in KINDS}
         self._rows: OrderedDict[tuple[str, int], tuple[FloatArray, np.ndarray]] = OrderedDict()
         self._row_limit = max(16, CACHE_BYTES // (12 * max(len(self.names), 1)))
+        self._routes: Kept[FloatArray | None] = Kept(ROUTES_KEPT)
+        self._places: Kept[str] = Kept(ROUTES_KEPT)
 
     def _graph(self, kind: str) -> csr_matrix:
         rows: list[int] = []
@@ -284,8 +287,12 @@ class Router:
 
     # -- queries --------------------------------------------------------------------------
     def place_of(self, point: FloatArray | tuple[float, ...]) -> str:
-        """Name of the convex place holding ``point``: a room id, a space id or ``outdoor``."""
+        """Name of the convex place holding ``point``: a room id, a space id or ``outdoor``
+        (kept per point; a point in a wall or off the site is an ``InputError``)."""
         p = np.asarray(point, dtype=float)
+        return self._places.get((p.shape, p.tobytes()), lambda: self._place_of(p))
+
+    def _place_of(self, p: FloatArray) -> str:
         room = self.world.room_at(p)
         if room is not None:
             return room.id
@@ -364,9 +371,13 @@ class Router:
 
     def route(self, start: FloatArray | tuple[float, ...], goal: FloatArray | tuple[float, ...],
               kind: str) -> FloatArray | None:
-        """Waypoints from ``start`` to ``goal`` at floor level, or ``None`` if unreachable."""
-        p = np.asarray(start, dtype=float)
-        q = np.asarray(goal, dtype=float)
+        """Waypoints from ``start`` to ``goal`` at floor level, or ``None`` if unreachable;
+        read-only, kept per ends and kind (the world does not change), up to ``ROUTES_KEPT``."""
+        p, q = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
+        return self._routes.get((kind, p.shape, p.tobytes(), q.shape, q.tobytes()),
+                                lambda: _read_only(self._route(p, q, kind)))
+
+    def _route(self, p: FloatArray, q: FloatArray, kind: str) -> FloatArray | None:
         p_place, q_place = self.place_of(p), self.place_of(q)
         if p_place == q_place and (p_place != "outdoor" or self._outdoor_clear(
                 p[None, :], q[None, :])[0]) and (p_place not in self._outlines or visible(
@@ -387,6 +398,12 @@ class Router:
         while nodes[-1] != a[i]:
             nodes.append(int(pred[i][nodes[-1]]))
         return np.vstack([p, self.positions[nodes[::-1]], q])
+
+
+def _read_only(way: FloatArray | None) -> FloatArray | None:
+    if way is not None:
+        way.flags.writeable = False
+    return way
 
 
 def _by_stairs(kind: KindDefaults, building: Building) -> bool:
