@@ -73,8 +73,10 @@ class PhysicsCoSim:
         self.local = LocalLayer(self, list(sim.robots))
         # a mover's body is added where it is at physics time, which the stepper keeps; the
         # stepper steps the bodies, so it is built second and the clock is read late
+        sleepers = [rid for rid, driver in self.drivers.items()
+                    if spec.sleep_idle and isinstance(driver, UgvDriver)]
         self.bodies = SceneBodies(self.client, self.drivers, self.lifts, sim.scene, sim.log,
-                                  clock=lambda: self.t)
+                                  clock=lambda: self.t, sleepers=sleepers)
         self.stepper = Stepper(self, sim.env, sim.log, spec, self.active, self.bodies,
                                self.local, self.execute)
         self.bodies.add_scene(sim.target)

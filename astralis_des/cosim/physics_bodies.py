@@ -5,7 +5,7 @@ the contacts of the moving robots with them."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -27,6 +27,7 @@ if TYPE_CHECKING:
 
 SUPPORT = 0.7  # a contact normal steeper than this holds a ground robot up: not a collision
 FLOORS = ("wall", "ground", "lift")  # what holds a ground robot up (slabs are static boxes)
+WAKE_RANGE = 2.0  # m between a mover's centre and a sleeping robot's that wakes it
 
 
 class SceneBodies:
@@ -34,9 +35,12 @@ class SceneBodies:
     the name of every body, and which robot touches what."""
 
     def __init__(self, client: PhysicsClient, drivers: dict[str, Driver], lifts: list[Lift],
-                 scene: Scene, log: EventLog, clock: Callable[[], float]) -> None:
-        """``clock`` gives the physics time now (a mover added is put where it is then)."""
+                 scene: Scene, log: EventLog, clock: Callable[[], float],
+                 sleepers: Sequence[str] = ()) -> None:
+        """``clock`` gives the physics time now (a mover added is put where it is then);
+        ``sleepers`` are the robots whose bodies sleep while idle (woken as a mover nears)."""
         self.client, self.drivers, self.log = client, drivers, log
+        self.sleepers = list(sleepers)
         self._scene = scene
         self._clock = clock
         self.names = {d.body: rid for rid, d in drivers.items()}
@@ -95,7 +99,18 @@ class SceneBodies:
         walker then jumps about 3 cm at a time; one far from every moving robot touches
         nothing and jumps when it comes near."""
         self.movers_time = then
-        self._put_movers([self.movers[index] for index in near], then)
+        moved = [self.movers[index] for index in near]
+        self._put_movers(moved, then)
+        if self.sleepers and moved:
+            self._wake_near(np.array([m.position_at(then)[:2] for m, _ in moved]))
+
+    def _wake_near(self, movers: FloatArray) -> None:
+        """Wake the sleeping robots a mover is about to walk into (a placed body pushes a
+        body that is awake, not one asleep)."""
+        for rid in self.sleepers:
+            here = self.drivers[rid].position()[:2]
+            if (np.linalg.norm(movers - here, axis=1) < WAKE_RANGE).any():
+                self.drivers[rid].wake()
 
     def place_movers(self, now: float) -> None:
         """Every mover where it is now, as a robot sets off: a body not moved while no robot
