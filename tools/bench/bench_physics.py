@@ -27,6 +27,7 @@ Goals (issue 43): >= 40x real time in the run with the default sensors; wall / t
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import subprocess
 import sys
@@ -128,7 +129,8 @@ def main() -> None:
         for _ in range(args.repeat):
             t0 = time.perf_counter()
             subprocess.run(["astralis", "run", args.mission, "--fidelity", "physics", "--out",
-                            tmp], capture_output=True, check=True)
+                            tmp], capture_output=True, check=True,
+                           env={**os.environ, "PYTHONPATH": str(ROOT)})  # this checkout's code
             whole.append(time.perf_counter() - t0)
     print(f"astralis run {Path(args.mission).name} --fidelity physics, the whole process with "
           f"the recording: median {statistics.median(whole):.2f} s of {args.repeat}, "
@@ -160,7 +162,9 @@ def team(size: int) -> list[dict[str, object]]:
 
 def team_curve(mission, sizes: list[int], raw_rate: float,  # type: ignore[no-untyped-def]
                sleep: bool) -> None:
-    physics = {**mission.spec.physics.model_dump(), "sleep_idle": sleep}
+    physics = mission.spec.physics.model_dump()
+    if sleep:  # only then: the curve runs on code without the option too (--awake)
+        physics["sleep_idle"] = True
     print("team-size curve: the default mission with n robots (half UAVs, half UGVs), physics, "
           f"default sensors, no outputs, idle UGVs {'asleep' if sleep else 'awake'} in Bullet:")
     print("  robots  simulated      wall  real-time  of raw  in stepSimulation  overhead  outcome")
