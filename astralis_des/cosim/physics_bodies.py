@@ -28,6 +28,7 @@ if TYPE_CHECKING:
 SUPPORT = 0.7  # a contact normal steeper than this holds a ground robot up: not a collision
 FLOORS = ("wall", "ground", "lift")  # what holds a ground robot up (slabs are static boxes)
 WAKE_RANGE = 2.0  # m between a mover's centre and a sleeping robot's that wakes it
+PLACES_AGE = 1.0  # s: the sleepers' places are read again this often (sleep takes 2 s still)
 
 
 class SceneBodies:
@@ -41,6 +42,8 @@ class SceneBodies:
         ``sleepers`` are the robots whose bodies sleep while idle (woken as a mover nears)."""
         self.client, self.drivers, self.log = client, drivers, log
         self.sleepers = list(sleepers)
+        self._places = np.zeros((len(self.sleepers), 2))  # where the sleepers stand, as of
+        self._places_at = -np.inf
         self._scene = scene
         self._clock = clock
         self.names = {d.body: rid for rid, d in drivers.items()}
@@ -102,15 +105,18 @@ class SceneBodies:
         moved = [self.movers[index] for index in near]
         self._put_movers(moved, then)
         if self.sleepers and moved:
-            self._wake_near(np.array([m.position_at(then)[:2] for m, _ in moved]))
+            self._wake_near(np.array([m.position_at(then)[:2] for m, _ in moved]), then)
 
-    def _wake_near(self, movers: FloatArray) -> None:
+    def _wake_near(self, movers: FloatArray, t: float) -> None:
         """Wake the sleeping robots a mover is about to walk into (a placed body pushes a
-        body that is awake, not one asleep)."""
-        for rid in self.sleepers:
-            here = self.drivers[rid].position()[:2]
-            if (np.linalg.norm(movers - here, axis=1) < WAKE_RANGE).any():
-                self.drivers[rid].wake()
+        body that is awake, not one asleep). Their places are read again every
+        ``PLACES_AGE`` s: a robot falls asleep only after standing still longer than that."""
+        if t >= self._places_at + PLACES_AGE:
+            self._places = np.array([self.drivers[rid].position()[:2] for rid in self.sleepers])
+            self._places_at = t
+        gaps = np.linalg.norm(self._places[:, None, :] - movers[None, :, :], axis=2)
+        for index in np.flatnonzero((gaps < WAKE_RANGE).any(axis=1)):
+            self.drivers[self.sleepers[index]].wake()
 
     def place_movers(self, now: float) -> None:
         """Every mover where it is now, as a robot sets off: a body not moved while no robot
