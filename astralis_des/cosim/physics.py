@@ -120,9 +120,9 @@ class PhysicsCoSim:
                   if other != rid and not isinstance(d, PlacedDriver)]
 
         def near(point: FloatArray) -> list[int]:
-            found = [d.body for d in others
-                     if abs(float(d.position()[0]) - float(point[0])) < 1.5
-                     and abs(float(d.position()[1]) - float(point[1])) < 1.5]
+            x, y = float(point[0]), float(point[1])
+            found = [d.body for d, (ox, oy, _) in ((d, d.position().tolist()) for d in others)
+                     if abs(ox - x) < 1.5 and abs(oy - y) < 1.5]
             return found + [lift.body for lift in self.lifts
                             if lift.contains(point, 1.0)]
 
