@@ -73,8 +73,10 @@ class PhysicsCoSim:
         self.local = LocalLayer(self, list(sim.robots))
         # a mover's body is added where it is at physics time, which the stepper keeps; the
         # stepper steps the bodies, so it is built second and the clock is read late
+        sleepers = [rid for rid, driver in self.drivers.items()
+                    if spec.sleep_idle and isinstance(driver, UgvDriver)]
         self.bodies = SceneBodies(self.client, self.drivers, self.lifts, sim.scene, sim.log,
-                                  clock=lambda: self.t)
+                                  clock=lambda: self.t, sleepers=sleepers)
         self.stepper = Stepper(self, sim.env, sim.log, spec, self.active, self.bodies,
                                self.local, self.execute)
         self.bodies.add_scene(sim.target)
@@ -118,9 +120,9 @@ class PhysicsCoSim:
                   if other != rid and not isinstance(d, PlacedDriver)]
 
         def near(point: FloatArray) -> list[int]:
-            found = [d.body for d in others
-                     if abs(float(d.position()[0]) - float(point[0])) < 1.5
-                     and abs(float(d.position()[1]) - float(point[1])) < 1.5]
+            x, y = float(point[0]), float(point[1])
+            found = [d.body for d, (ox, oy, _) in ((d, d.position().tolist()) for d in others)
+                     if abs(ox - x) < 1.5 and abs(oy - y) < 1.5]
             return found + [lift.body for lift in self.lifts
                             if lift.contains(point, 1.0)]
 

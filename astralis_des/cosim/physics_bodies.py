@@ -5,7 +5,7 @@ the contacts of the moving robots with them."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -27,6 +27,8 @@ if TYPE_CHECKING:
 
 SUPPORT = 0.7  # a contact normal steeper than this holds a ground robot up: not a collision
 FLOORS = ("wall", "ground", "lift")  # what holds a ground robot up (slabs are static boxes)
+WAKE_RANGE = 2.0  # m between a mover's centre and a sleeping robot's that wakes it
+PLACES_AGE = 1.0  # s: the sleepers' places are read again this often (sleep takes 2 s still)
 
 
 class SceneBodies:
@@ -34,9 +36,14 @@ class SceneBodies:
     the name of every body, and which robot touches what."""
 
     def __init__(self, client: PhysicsClient, drivers: dict[str, Driver], lifts: list[Lift],
-                 scene: Scene, log: EventLog, clock: Callable[[], float]) -> None:
-        """``clock`` gives the physics time now (a mover added is put where it is then)."""
+                 scene: Scene, log: EventLog, clock: Callable[[], float],
+                 sleepers: Sequence[str] = ()) -> None:
+        """``clock`` gives the physics time now (a mover added is put where it is then);
+        ``sleepers`` are the robots whose bodies sleep while idle (woken as a mover nears)."""
         self.client, self.drivers, self.log = client, drivers, log
+        self.sleepers = list(sleepers)
+        self._places = np.zeros((len(self.sleepers), 2))  # where the sleepers stand, as of
+        self._places_at = -np.inf
         self._scene = scene
         self._clock = clock
         self.names = {d.body: rid for rid, d in drivers.items()}
@@ -95,7 +102,21 @@ class SceneBodies:
         walker then jumps about 3 cm at a time; one far from every moving robot touches
         nothing and jumps when it comes near."""
         self.movers_time = then
-        self._put_movers([self.movers[index] for index in near], then)
+        moved = [self.movers[index] for index in near]
+        self._put_movers(moved, then)
+        if self.sleepers and moved:
+            self._wake_near(np.array([m.position_at(then)[:2] for m, _ in moved]), then)
+
+    def _wake_near(self, movers: FloatArray, t: float) -> None:
+        """Wake the sleeping robots a mover is about to walk into (a placed body pushes a
+        body that is awake, not one asleep). Their places are read again every
+        ``PLACES_AGE`` s: a robot falls asleep only after standing still longer than that."""
+        if t >= self._places_at + PLACES_AGE:
+            self._places = np.array([self.drivers[rid].position()[:2] for rid in self.sleepers])
+            self._places_at = t
+        gaps = np.linalg.norm(self._places[:, None, :] - movers[None, :, :], axis=2)
+        for index in np.flatnonzero((gaps < WAKE_RANGE).any(axis=1)):
+            self.drivers[self.sleepers[index]].wake()
 
     def place_movers(self, now: float) -> None:
         """Every mover where it is now, as a robot sets off: a body not moved while no robot

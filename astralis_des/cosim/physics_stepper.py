@@ -53,6 +53,8 @@ class Stepper:
         self._asked: Requests = {}  # robots asked to make way in this macro-step
         self._no_room: dict[str, float] = {}  # robots that found no spot to make way, until
         self._ticks = 0
+        site = engine.world.site
+        self._site = (float(site[0]) + 5.0, float(site[1]) + 5.0)  # beyond this: left the world
 
     def wake(self) -> None:
         """A robot was handed over: step again if idle."""
@@ -119,12 +121,10 @@ class Stepper:
             return MotionOutcome(True, "arrived")
         if not check:
             return None
-        here = track.driver.position()
-        if not np.all(np.isfinite(here)):
+        x, y, z = track.driver.position().tolist()  # plain floats: numpy costs more here
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
             return MotionOutcome(False, "the physics state became NaN")
-        site = self.engine.world.site
-        if not (-5.0 <= here[0] <= site[0] + 5.0 and -5.0 <= here[1] <= site[1] + 5.0
-                and -1.0 <= here[2] <= 200.0):
+        if not (-5.0 <= x <= self._site[0] and -5.0 <= y <= self._site[1] and -1.0 <= z <= 200.0):
             return MotionOutcome(False, "left the world")
         crash = track.driver.crashed()
         if crash is not None:

@@ -262,6 +262,9 @@ class PhysicsSpec(Strict):
     log_rate: PositiveFloat = Field(10.0, description="pose samples per s in the recording")
     stuck_timeout: PositiveFloat = Field(15.0, description="s without progress: the action fails")
     solver_iterations: Annotated[int, Field(ge=1, le=200)] = 20
+    sleep_idle: bool = Field(
+        False, description="an idle UGV sleeps in Bullet once settled, woken by a command or a "
+        "touch: big teams step several times faster; trajectories differ by millimetres")
     uav: HexacopterSpec = Field(default_factory=HexacopterSpec)
 
     @model_validator(mode="after")

@@ -73,7 +73,9 @@ class Hexacopter:
         self.motor_alpha = 1.0 if lag == 0 else 1.0 - math.exp(-control_period / lag)
         self.max_speed = 3.0
         self.max_horizontal = min(spec.max_accel, GRAVITY * self.tilt)
-        self._geometry = [(tuple(self.mix[i]), (float(self.rotors[i, 0]), float(self.rotors[i, 1])),
+        # plain floats (numpy's scalars cost ten times more each; the arithmetic is the same)
+        self._geometry = [(tuple(self.mix[i].tolist()),
+                           (float(self.rotors[i, 0]), float(self.rotors[i, 1])),
                            float(self.spin[i])) for i in range(ROTORS)]
         self.hover_speed = hover
         self.rotor_speed = [hover] * ROTORS
@@ -161,14 +163,16 @@ class Hexacopter:
         kf, km = self.spec.thrust_constant, self.spec.moment_constant
         r00, r01, r02, r10, r11, r12, r20, r21, r22 = rot
         ux, uy, uz = r02, r12, r22
+        w0, w1, w2, w3 = wrench
+        ceiling, alpha, speeds, sqrt = self.max_thrust, self.motor_alpha, self.rotor_speed, \
+            math.sqrt
         drag = total = 0.0
         mx = my = mz = 0.0  # sum of thrust x the arm's end, relative to the centre of mass
-        for i, (mix, (ox, oy), spin) in enumerate(self._geometry):
-            wanted = min(max(mix[0] * wrench[0] + mix[1] * wrench[1] + mix[2] * wrench[2]
-                             + mix[3] * wrench[3], 0.0), self.max_thrust)
-            speed = self.rotor_speed[i]
-            speed += (math.sqrt(wanted / kf) - speed) * self.motor_alpha
-            self.rotor_speed[i] = speed
+        for i, ((m0, m1, m2, m3), (ox, oy), spin) in enumerate(self._geometry):
+            wanted = min(max(m0 * w0 + m1 * w1 + m2 * w2 + m3 * w3, 0.0), ceiling)
+            speed = speeds[i]
+            speed += (sqrt(wanted / kf) - speed) * alpha
+            speeds[i] = speed
             f = kf * speed * speed
             drag += spin * f
             total += f

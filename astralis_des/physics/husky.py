@@ -29,8 +29,11 @@ REST_Z = 0.155  # m: the base's height above the floor it stands on (measured at
 
 
 class Husky:
-    def __init__(self, client: PhysicsClient, start: FloatArray) -> None:
+    def __init__(self, client: PhysicsClient, start: FloatArray, sleeps: bool = False) -> None:
+        """``sleeps``: standing idle (``rest``), it may sleep in Bullet."""
         self.client = client
+        self.sleeps = sleeps
+        self.resting = False  # idle, and allowed to sleep
         with quiet_c_output():
             self.body = int(client.call(
                 "loadURDF", "husky/husky.urdf", [float(start[0]), float(start[1]),
@@ -51,6 +54,22 @@ class Husky:
         self.offset = np.zeros(2)  # shift of the pursued point (keeping right)
         self.spinning = False  # turning on the spot to face the path
         self.drive(0.0, 0.0)
+
+    def rest(self) -> None:
+        """Standing idle: Bullet may put it to sleep once it has settled (it then costs the
+        solver next to nothing) and wakes it when a moving body touches it."""
+        self.resting = True
+        if self.sleeps:
+            self.client.call("changeDynamics", self.body, -1,
+                             activationState=pb.ACTIVATION_STATE_ENABLE_SLEEPING)
+
+    def wake(self) -> None:
+        """Awake and kept awake: it is driven (a sleeping body would not answer its wheels)."""
+        self.resting = False
+        if self.sleeps:
+            self.client.call("changeDynamics", self.body, -1,
+                             activationState=pb.ACTIVATION_STATE_WAKE_UP
+                             | pb.ACTIVATION_STATE_DISABLE_SLEEPING)
 
     def pose(self) -> tuple[float, float, float, float]:
         """x, y, z of the base, and heading."""

@@ -34,6 +34,7 @@ from astralis_des.kernel.robot import Robot
 from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.mission.spec import CameraSpec, ImuSpec, Lidar3dSpec, LidarSpec
 from astralis_des.physics.lidar3d import Lidar3D
+from astralis_des.physics.offscreen import Offscreen
 from astralis_des.physics.sensors import Camera, Frame, Imu, Intrinsics, Lidar2D
 from astralis_des.sensing import Sighting, in_frame
 from astralis_des.streams import stream
@@ -73,16 +74,18 @@ class SensorClock:
 class Eyes:
     """A robot's camera: full resolution to detect, half to keep frames."""
 
-    def __init__(self, cosim: Engine, robot: Robot, spec: CameraSpec, view: View) -> None:
+    def __init__(self, cosim: Engine, robot: Robot, spec: CameraSpec, view: View,
+                 offscreen: Offscreen) -> None:
         body = cosim.drivers[robot.id].body
         mount = _mount(cosim, robot.id)
         self.spec, self.view = spec, view
         far = 2.0 * view.reach + 1.0  # past any detection, off-axis views included
         k = Intrinsics(spec.width, spec.height, view.fov_deg, far=far)
-        self.full = Camera(cosim.client, body, k, mount, view.pitch_deg)
+        self.full = Camera(cosim.client, body, k, mount, view.pitch_deg, offscreen=offscreen)
         small = Intrinsics(max(spec.width // 2, 1), max(spec.height // 2, 1), view.fov_deg,
                            far=far)
-        self.small = Camera(cosim.client, body, small, mount, view.pitch_deg)
+        self.small = Camera(cosim.client, body, small, mount, view.pitch_deg,
+                            offscreen=offscreen)
         self.next_keep = 0.0
 
 
@@ -101,11 +104,12 @@ class Perception:
         self.clouds: list[KeptCloud] = []
         self.imus: dict[str, tuple[Imu, ImuSpec]] = {}
         seed = sim.mission.spec.seed
+        offscreen = Offscreen(cosim.client, [d.body for d in cosim.drivers.values()])
         for index, member in enumerate(sim.mission.spec.team):
             robot, sensors = sim.robots[member.id], member.sensor_set
             body = cosim.drivers[member.id].body
             if sensors.camera is not None and robot.view is not None:
-                self.eyes[member.id] = Eyes(cosim, robot, sensors.camera, robot.view)
+                self.eyes[member.id] = Eyes(cosim, robot, sensors.camera, robot.view, offscreen)
             if sensors.lidar is not None:
                 spec = sensors.lidar
                 self.lidars[member.id] = (Lidar2D(

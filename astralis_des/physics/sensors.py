@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import logging
 import math
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,6 +22,7 @@ from numpy.typing import NDArray
 
 from astralis_des.kernel.perceived import ImuReading, Intrinsics
 from astralis_des.physics.client import GRAVITY, PhysicsClient, beams_near_bodies
+from astralis_des.physics.offscreen import Offscreen
 from astralis_des.world.geometry import FloatArray
 
 __all__ = ["Camera", "Frame", "Imu", "ImuReading", "Intrinsics", "Lidar2D", "Scan"]
@@ -86,8 +88,11 @@ class Camera:
 
     def __init__(self, client: PhysicsClient, body: int, intrinsics: Intrinsics,
                  mount: Vec3 = (0.0, 0.0, 0.0), pitch_deg: float = 0.0,
-                 renderer: int = pb.ER_TINY_RENDERER, hide_body: bool = True) -> None:
+                 renderer: int = pb.ER_TINY_RENDERER, hide_body: bool = True,
+                 offscreen: Offscreen | None = None) -> None:
+        """``offscreen``: other bodies to leave out of a frame they cannot show in."""
         self.client, self.body, self.intrinsics, self.renderer = client, body, intrinsics, renderer
+        self.offscreen = offscreen
         self.mount = np.asarray(mount, dtype=float)
         p = math.radians(pitch_deg)
         forward = np.array([math.cos(p), 0.0, -math.sin(p)])
@@ -124,9 +129,11 @@ class Camera:
         k = self.intrinsics
         self._paint(hidden=True)
         try:
-            _, _, rgba, buffer, seg = self.client.call(
-                "getCameraImage", k.width, k.height, view, self.projection,
-                renderer=self.renderer)
+            with nullcontext() if self.offscreen is None else \
+                    self.offscreen.hidden(eye, rotation, k, skip=self.body):
+                _, _, rgba, buffer, seg = self.client.call(
+                    "getCameraImage", k.width, k.height, view, self.projection,
+                    renderer=self.renderer)
         finally:
             self._paint(hidden=False)
         rgb = np.asarray(rgba, dtype=np.uint8).reshape(k.height, k.width, 4)[:, :, :3]

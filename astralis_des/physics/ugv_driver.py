@@ -50,8 +50,10 @@ class UgvDriver(Avoiding):
         self.id = robot.id
         self.height = robot.height
         self.floor = float(robot.pose[2] - robot.height)
-        self.husky = Husky(client, robot.pose - np.array([0.0, 0.0, robot.height]))
+        self.husky = Husky(client, robot.pose - np.array([0.0, 0.0, robot.height]),
+                           sleeps=spec.sleep_idle)
         self.body = self.husky.body
+        self.husky.rest()
         self.legs: list[Leg] = []
         self.speed = robot.speed
         self.ride: tuple[Lift, float, float] | None = None  # the lift, from and to levels
@@ -106,6 +108,7 @@ class UgvDriver(Avoiding):
     # -- motions ---------------------------------------------------------------------------
     def turn_to(self, heading: float) -> bool:
         """Turn on the spot until the body faces ``heading`` (True: it turns)."""
+        self.husky.wake()
         self.legs = []
         self.ride = None
         self.motion = None
@@ -117,6 +120,7 @@ class UgvDriver(Avoiding):
         return True
 
     def start(self, motion: Motion, t: float) -> None:
+        self.husky.wake()
         self.turning = False
         self.motion = motion
         floor = motion.points - np.array([0.0, 0.0, self.height])
@@ -317,6 +321,14 @@ class UgvDriver(Avoiding):
                          self.client.call("getQuaternionFromEuler", [0, 0, yaw]))
         self.client.call("resetBaseVelocity", self.body, [0, 0, 0], [0, 0, 0])
         self.floor = float(at[2])
+        self.wake()  # to settle where it was put
+
+    def wake(self) -> None:
+        """Awake (a mover comes near, it was put somewhere); asleep again once settled. A
+        driven body is awake already."""
+        if self.husky.resting:
+            self.husky.wake()
+            self.husky.rest()
 
     def freeze(self) -> None:
         """Stop the wheels. Halted in the middle of a ride, the lift first brings it to the
@@ -333,3 +345,4 @@ class UgvDriver(Avoiding):
             self.floor = level
             lift.moving = False
             self.ride = None
+        self.husky.rest()

@@ -7,10 +7,8 @@ occupied cell's centre: what ``scipy.ndimage.distance_transform_edt(~occupied,
 sampling=resolution)`` gives (0 on occupied cells, inf when nothing is occupied).
 
 The 3-D field is found from the boxes rather than by scipy, which takes 18 s for the 62 M voxels
-of the default world. A box's occupied cells are a product of three index ranges, so the
-distance to it is separable, and the distance to all boxes is the minimum over them. Each box
-is swept only over the cells it could be nearest to: closer than a box covering the whole map
-(the ground) is, layer by layer.
+of the default world, one horizontal layer at a time as queries reach it
+(:mod:`astralis_des.planning.layers`).
 """
 
 from __future__ import annotations
@@ -27,6 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
 from astralis_des.memo import kept
+from astralis_des.planning.layers import LayerField, Layers
 from astralis_des.world.geometry import FloatArray
 from astralis_des.world.model import World
 
@@ -70,7 +69,7 @@ class _FieldGrid:
         return self._field.at(self.cell_of(points))
 
     @cached_property
-    def _field(self) -> _Field:
+    def _field(self) -> _Field | LayerField:
         return _Field(self.distance)
 
     def free(self, points: ArrayLike, radius: float) -> BoolArray:
@@ -97,13 +96,19 @@ class GridMap(_FieldGrid):
 class VoxelMap(_FieldGrid):
     """A 3-D occupancy grid (``(nx, ny, nz)``) and its distance field; arrays are read-only
     and may be shared. Built from boxes, the map keeps the squared distance in cells
-    (``squared``, 2 bytes a voxel) and answers clearance queries from it; the full
-    occupancy and float32 distance arrays are made only when asked for (they would take
-    5 bytes more a voxel, and most of a fresh process's time building the map)."""
+    (``squared``, 2 bytes a voxel), made a layer at a time as clearance queries reach it
+    (``layers``); the whole of it, and the full occupancy and float32 distance arrays, are
+    made only when asked for (they would take 5 bytes more a voxel, and most of a fresh
+    process's time building the map)."""
 
-    squared: NDArray[np.unsignedinteger] | None = None  # (nx, ny, nz) cells^2 (a view)
     dense: tuple[BoolArray, NDArray[np.float32]] | None = None  # occupied, distance
-    blocks: tuple[IntArray, IntArray] | None = None  # with squared: the boxes' cell ranges
+    blocks: tuple[IntArray, IntArray] | None = None  # with layers: the boxes' cell ranges
+    layers: Layers | None = None  # built from boxes: squared distances, a layer at a time
+
+    @cached_property
+    def squared(self) -> NDArray[np.unsignedinteger] | None:
+        """``(nx, ny, nz)`` squared distances in cells (a view), every layer made."""
+        return None if self.layers is None else _frozen(self.layers.whole())
 
     @cached_property
     def occupied(self) -> BoolArray:
@@ -122,7 +127,7 @@ class VoxelMap(_FieldGrid):
     def occupied_cells(self, above: float) -> IntArray:
         """Indices of the occupied voxels whose centres lie higher than ``above``, in the
         order of ``np.argwhere(occupied)`` (only the layers above are looked at)."""
-        nz = (self.squared if self.squared is not None else self.occupied).shape[2]
+        nz = (self.layers.shape if self.layers is not None else self.occupied.shape)[2]
         layers = np.column_stack([np.zeros((nz, 2)), np.arange(nz)])
         higher = np.flatnonzero(self.center_of(layers)[:, 2] > above)
         if not len(higher):
@@ -134,8 +139,8 @@ class VoxelMap(_FieldGrid):
             return cells
         # the occupied voxels are those of the boxes' cell ranges: listed box by box, then
         # each once, in the order of np.argwhere
-        assert self.squared is not None  # boxes' ranges come with the squared distances
-        shape = self.squared.shape
+        assert self.layers is not None  # boxes' ranges come with the squared distances
+        shape = self.layers.shape
         flat = []
         for first, stop in zip(*self.blocks, strict=True):
             first = np.maximum(first, (0, 0, k0))
@@ -148,11 +153,11 @@ class VoxelMap(_FieldGrid):
         return np.column_stack(np.unravel_index(np.unique(np.concatenate(flat)), shape))
 
     @cached_property
-    def _field(self) -> _Field:
-        if self.squared is None:
+    def _field(self) -> _Field | LayerField:
+        if self.layers is None:
             return _Field(self.distance)
         resolution = self.resolution
-        return _Field(self.squared, lambda cells2: _metres(cells2, resolution))
+        return LayerField(self.layers, lambda cells2: _metres(cells2, resolution))
 
     def segment_free(self, p0: ArrayLike, p1: ArrayLike, radius: float) -> bool:
         """Is every point of the segment, sampled every half voxel, free for ``radius``?"""
@@ -202,10 +207,10 @@ def from_boxes(boxes: ArrayLike, lo: ArrayLike, hi: ArrayLike,
         occupied = np.zeros((nx, ny, nz), dtype=bool)
         distance = np.full((nx, ny, nz), np.inf, dtype=np.float32)
         return VoxelMap(_frozen(lo_), resolution, dense=(_frozen(occupied), _frozen(distance)))
-    d2 = _squared_distances(first[keep], stop[keep], (nx, ny, nz))
-    # Computed layer-major (z, x, y) so each layer is contiguous; exposed as (x, y, z) views.
-    return VoxelMap(_frozen(lo_), resolution, squared=_frozen(d2.transpose(1, 2, 0)),
-                    blocks=(_frozen(first[keep]), _frozen(stop[keep])))
+    # made layer-major (z, x, y) so each layer is contiguous; exposed as (x, y, z) views
+    blocks = (_frozen(first[keep]), _frozen(stop[keep]))
+    return VoxelMap(_frozen(lo_), resolution, blocks=blocks,
+                    layers=Layers(blocks[0], blocks[1], (nx, ny, nz)))
 
 
 def world_map(world: World, extra: ArrayLike | None = None, resolution: float | None = None,
@@ -264,39 +269,6 @@ def from_boxes_rasterised(boxes: ArrayLike, lo: ArrayLike, hi: ArrayLike,
         occupied[i0:i1, j0:j1, k0:k1] = True
     return VoxelMap(_frozen(lo_), resolution,
                     dense=(_frozen(occupied), _frozen(_edt(occupied, resolution))))
-
-
-def _squared_distances(first: IntArray, stop: IntArray,
-                       shape: tuple[int, int, int]) -> NDArray[np.unsignedinteger]:
-    """``(nz, nx, ny)`` squared distance, in cells, to the nearest cell of any box.
-
-    Box ``b`` occupies cells ``first[b] <= index < stop[b]``.
-    """
-    nx, ny, nz = shape
-    layers = np.arange(nz)
-    gap_z = _gaps(first[:, 2, None], stop[:, 2, None], layers)  # (K, nz)
-    covers = np.all(first[:, :2] == 0, axis=1) & np.all(stop[:, :2] == (nx, ny), axis=1)
-    # No cell is farther from its nearest box than from a box covering every column.
-    reach = gap_z[covers].min(axis=0) if covers.any() else \
-        np.full(nz, math.ceil(math.hypot(nx, ny, nz)))
-    dtype = np.uint16 if 3 * int(reach.max()) ** 2 < np.iinfo(np.uint16).max else np.uint32
-    d2 = np.full((nz, nx, ny), np.iinfo(dtype).max, dtype)
-    ix, iy = np.arange(nx), np.arange(ny)
-    for (i0, j0, _), (i1, j1, _), gz in zip(first, stop, gap_z, strict=True):
-        for k in np.flatnonzero(gz <= reach):
-            w = math.isqrt(int(reach[k]) ** 2 - int(gz[k]) ** 2)
-            xa, xb, ya, yb = max(i0 - w, 0), min(i1 + w, nx), max(j0 - w, 0), min(j1 + w, ny)
-            gx: NDArray[Any] = _gaps(i0, i1, ix[xa:xb]).astype(dtype)
-            gy: NDArray[Any] = _gaps(j0, j1, iy[ya:yb]).astype(dtype)
-            window = d2[k, xa:xb, ya:yb]
-            np.minimum(window, (gx * gx + dtype(gz[k] ** 2))[:, None] + (gy * gy)[None, :],
-                       out=window)
-    return d2
-
-
-def _gaps(first: IntArray | int, stop: IntArray | int, index: IntArray) -> IntArray:
-    """Cells between ``index`` and the range ``first <= i < stop`` (0 inside it)."""
-    return np.maximum(np.maximum(first - index, index - (stop - 1)), 0)
 
 
 def _edt(occupied: BoolArray, resolution: float) -> NDArray[np.float32]:
