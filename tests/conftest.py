@@ -35,6 +35,7 @@ if os.environ.pop("PYTHONDONTWRITEBYTECODE", None) and "PYTHONPYCACHEPREFIX" not
 
 if TYPE_CHECKING:
     from astralis_des.api.client import Client
+    from astralis_des.physics.client import PhysicsClient
 
 ROOT = Path(__file__).resolve().parents[1]
 MISSIONS = ROOT / "missions"
@@ -44,6 +45,18 @@ DEFAULT_WORLD = ROOT / "worlds" / "urban_default.yaml"
 @pytest.fixture(scope="session")
 def world() -> World:
     return load_world(DEFAULT_WORLD)
+
+
+@pytest.fixture()
+def physics_client(world: World) -> Iterator[PhysicsClient]:
+    """A bare physics client of the default world, at the physics' default rates."""
+    from astralis_des.mission.spec import PhysicsSpec
+    from astralis_des.physics.client import PhysicsClient
+
+    spec = PhysicsSpec()
+    client = PhysicsClient(world, spec.dt, spec.rate // spec.control_rate, spec.solver_iterations)
+    yield client
+    client.close()
 
 
 @pytest.fixture(scope="session")

@@ -3,15 +3,10 @@ body that is awake); a mission whose idle UGVs sleep runs to its end."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-
 import numpy as np
-import pytest
 
 from astralis_des.cosim.physics_bodies import WAKE_RANGE, SceneBodies
-from astralis_des.mission.spec import PhysicsSpec
 from astralis_des.physics.client import PhysicsClient
-from astralis_des.world.model import World
 from astralis_des.world.scene import Mover
 
 
@@ -28,19 +23,11 @@ class Sleeper:
         self.woken += 1
 
 
-@pytest.fixture()
-def client(world: World) -> Iterator[PhysicsClient]:
-    spec = PhysicsSpec()
-    client = PhysicsClient(world, spec.dt, spec.rate // spec.control_rate, spec.solver_iterations)
-    yield client
-    client.close()
-
-
-def test_a_mover_wakes_the_sleepers_within_range_only(client: PhysicsClient) -> None:
+def test_a_mover_wakes_the_sleepers_within_range_only(physics_client: PhysicsClient) -> None:
     """A walker heading along y = 30 wakes the robot beside its way, not the one 5 m off."""
     near, far = Sleeper(-10, (31.0, 31.0)), Sleeper(-11, (31.0, 35.0))
     drivers = {"ugv1": near, "ugv2": far}
-    bodies = SceneBodies(client, drivers, [], scene=None, log=None,  # type: ignore[arg-type]
+    bodies = SceneBodies(physics_client, drivers, [], scene=None, log=None,  # type: ignore[arg-type]
                          clock=lambda: 0.0, sleepers=["ugv1", "ugv2"])
     loop = np.array([[30.0, 30.0, 0.85], [40.0, 30.0, 0.85], [30.0, 30.0, 0.85]])
     bodies.add_movers([Mover("avatar1", "avatar", loop, 1.0, (0.5, 0.5, 1.7))])

@@ -24,11 +24,8 @@ K = Intrinsics(320, 240, 60.0)
 
 
 @pytest.fixture()
-def client(world: World) -> Iterator[PhysicsClient]:
-    spec = PhysicsSpec()
-    client = PhysicsClient(world, spec.dt, spec.rate // spec.control_rate, spec.solver_iterations)
-    yield client
-    client.close()
+def client(physics_client: PhysicsClient) -> PhysicsClient:
+    return physics_client
 
 
 def robot(client: PhysicsClient, at: np.ndarray) -> int:
