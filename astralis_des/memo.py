@@ -14,13 +14,17 @@ What is kept, on what (``kept(owner, NAME)``):
   ``coverage`` and ``first_pass`` (how much of a room a sweep sees), ``sky`` (the GNSS's open
   sky), ``ducked`` (legs that duck under a lintel), and its router's Dijkstra rows
   (``world.routing``, its own cache, at most 256 MB);
+- on a world's **router**: ``routes`` (waypoints, by ends and kind, read-only) and
+  ``places`` (the place of a point);
 - on a **voxel map**: ``occupied_points`` (its occupied cells' centres);
 - on a room's **free space**: ``empty_reach`` (where a robot reaches in the empty room) and
   ``wall_backs`` (where a footprint's back lies along a wall, by wall and footprint).
 
 Elsewhere, once per process and by value (``functools``): the packaged clutter catalogue, the
 ROS 2 message types, a camera's swath by view and height, a catalogue without its furniture,
-and the built worlds themselves (by file content and the robot kinds registered).
+a motion's course by path and speed parameters (with the sighting samples along it,
+``kernel.course``), and the built worlds themselves (by file content and the robot kinds
+registered).
 
 The registries (kinds, actions, strategies, planners, drivers, looks, event kinds) fill as
 their modules and the plug-ins are imported, and last for the process: a plug-in a mission
@@ -32,7 +36,8 @@ from __future__ import annotations
 from typing import Any
 
 NAMES = frozenset({"voxel_map", "block_field", "free_space", "furnished", "coverage",
-                   "first_pass", "sky", "ducked", "occupied_points", "empty_reach", "wall_backs"})
+                   "first_pass", "sky", "ducked", "occupied_points", "empty_reach", "wall_backs",
+                   "routes", "places"})
 
 
 def kept(owner: object, name: str, limit: int | None = None) -> dict[Any, Any]:

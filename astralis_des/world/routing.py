@@ -12,7 +12,7 @@ import itertools
 import math
 from collections import OrderedDict
 from collections.abc import Sequence
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -20,9 +20,9 @@ from scipy.sparse.csgraph import dijkstra
 
 from astralis_des.errors import InputError
 from astralis_des.kinds import KIND_DEFAULTS, KINDS, KindDefaults
+from astralis_des.memo import kept
 from astralis_des.world.geometry import FloatArray, boxes_array, segments_hit_boxes
 from astralis_des.world.interior_routes import reflex_corners, side_of, visible
-from astralis_des.world.kept import Kept
 from astralis_des.world.parts import BLOCK, Building, InteriorPlan, Room, Solid, Space
 
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
@@ -87,8 +87,6 @@ class Router:
         self._graphs = {kind: self._graph(kind) for kind in KINDS}
         self._rows: OrderedDict[tuple[str, int], tuple[FloatArray, np.ndarray]] = OrderedDict()
         self._row_limit = max(16, CACHE_BYTES // (12 * max(len(self.names), 1)))
-        self._routes: Kept[FloatArray | None] = Kept(ROUTES_KEPT)
-        self._places: Kept[str] = Kept(ROUTES_KEPT)
 
     def _graph(self, kind: str) -> csr_matrix:
         rows: list[int] = []
@@ -290,7 +288,11 @@ class Router:
         """Name of the convex place holding ``point``: a room id, a space id or ``outdoor``
         (kept per point; a point in a wall or off the site is an ``InputError``)."""
         p = np.asarray(point, dtype=float)
-        return self._places.get((p.shape, p.tobytes()), lambda: self._place_of(p))
+        places: dict[tuple[Any, ...], str] = kept(self, "places", ROUTES_KEPT)
+        key = (p.shape, p.tobytes())
+        if key not in places:
+            places[key] = self._place_of(p)
+        return places[key]
 
     def _place_of(self, p: FloatArray) -> str:
         room = self.world.room_at(p)
@@ -374,8 +376,11 @@ class Router:
         """Waypoints from ``start`` to ``goal`` at floor level, or ``None`` if unreachable;
         read-only, kept per ends and kind (the world does not change), up to ``ROUTES_KEPT``."""
         p, q = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
-        return self._routes.get((kind, p.shape, p.tobytes(), q.shape, q.tobytes()),
-                                lambda: _read_only(self._route(p, q, kind)))
+        routes: dict[tuple[Any, ...], FloatArray | None] = kept(self, "routes", ROUTES_KEPT)
+        key = (kind, p.shape, p.tobytes(), q.shape, q.tobytes())
+        if key not in routes:
+            routes[key] = _read_only(self._route(p, q, kind))
+        return routes[key]
 
     def _route(self, p: FloatArray, q: FloatArray, kind: str) -> FloatArray | None:
         p_place, q_place = self.place_of(p), self.place_of(q)
