@@ -121,7 +121,6 @@ def reachable(space: FreeSpace, taken: BoolArray, passage: float,
     return eroded, from_door[labels]
 
 
-
 def eroded_after(space: FreeSpace, taken: BoolArray, walk_eroded: BoolArray,
                  taken_before: BoolArray, stamped: Cells, radius: float) -> BoolArray:
     """The walkable floor eroded by ``radius`` cells once the cells ``stamped`` are taken
