@@ -13,8 +13,7 @@ What is kept, on what (``kept(owner, NAME)``):
   room's free floor, by cell size), ``furnished`` (a room's furniture, by its draw),
   ``coverage`` and ``first_pass`` (how much of a room a sweep sees), ``sky`` (the GNSS's open
   sky), ``ducked`` (legs that duck under a lintel), and its router's Dijkstra rows
-  (``world.routing``, its own cache, at most 256 MB); ``recorded`` (its solids as Rerun
-  chunks, prepared the second time a process records it);
+  (``world.routing``, its own cache, at most 256 MB);
 - on a world's **router**: ``routes`` (waypoints, by ends and kind, read-only) and
   ``places`` (the place of a point);
 - on a **voxel map**: ``occupied_points`` (its occupied cells' centres);
@@ -24,8 +23,7 @@ What is kept, on what (``kept(owner, NAME)``):
 Elsewhere, once per process and by value (``functools``): the packaged clutter catalogue, the
 ROS 2 message types, a camera's swath by view and height, a catalogue without its furniture,
 a motion's course by path and speed parameters (with the sighting samples along it,
-``kernel.course``), a layout's blueprint encoded by recording and layout
-(``sinks.blueprint``), and the built worlds themselves (by file content and the robot kinds
+``kernel.course``), and the built worlds themselves (by file content and the robot kinds
 registered).
 
 The registries (kinds, actions, strategies, planners, drivers, looks, event kinds) fill as
@@ -39,7 +37,7 @@ from typing import Any
 
 NAMES = frozenset({"voxel_map", "block_field", "free_space", "furnished", "coverage",
                    "first_pass", "sky", "ducked", "occupied_points", "empty_reach", "wall_backs",
-                   "routes", "places", "recorded"})
+                   "routes", "places"})
 
 
 def kept(owner: object, name: str, limit: int | None = None) -> dict[Any, Any]:

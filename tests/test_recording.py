@@ -112,12 +112,12 @@ def test_a_mission_run_again_in_one_process_records_the_same(tmp_path: Path) -> 
     """The second run of a mission in a process prepares the world's solids as chunks and
     keeps its layout encoded; the third sends both as they are. Its recording holds the same
     rows, the same views and its blueprint made active, and reads back whole."""
-    from astralis_des.sinks import blueprint
+    from astralis_des.sinks import blueprint, prepared
     from astralis_des.sinks.rrd_check import FILE_MAGIC, HEADER, MESSAGE
 
-    mission = load_mission(ROOT / "missions" / "faults.yaml")
-    mission.world.memo("recorded", 4).clear()  # as if the process had not recorded it yet
+    prepared._PREPARED.clear()
     blueprint._SEEN.clear()
+    mission = load_mission(ROOT / "missions" / "faults.yaml")
     rrds = []
     for n in range(3):
         Simulation(mission, out_dir=tmp_path / str(n)).run()

@@ -1,6 +1,6 @@
 """Static parts of a recording that are the same from run to run (a world's walls, slabs and
-imported blocks, mesh or cloud), prepared once per world and process and sent to each later
-recording as chunks.
+imported blocks, mesh or cloud), prepared once per process and sent to each later recording
+as chunks.
 
 Each ``log`` call of Rerun's Python SDK converts its archetype anew, about 0.1 to 0.5 ms; a
 prepared chunk is sent as it is (the default world's solids: 2.4 ms logged, 0.2 ms sent).
@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import tempfile
+from collections import OrderedDict
 from collections.abc import Callable, Hashable
 from pathlib import Path
 from typing import Any
@@ -19,18 +20,25 @@ from astralis_des.sinks.blueprint import APPLICATION
 
 log = logging.getLogger(__name__)
 
+KEPT = 32  # prepared parts a process keeps (the least recently sent go first)
+_PREPARED: OrderedDict[Hashable, tuple[Any, list[Any] | None]] = OrderedDict()
 
-def send_prepared(rr: Any, rec: Any, cache: dict[Hashable, list[Any] | None], key: Hashable,
+
+def send_prepared(rr: Any, rec: Any, key: Hashable, owner: Any,
                   logged: Callable[[Any], None]) -> None:
-    """Send to ``rec`` what ``logged(stream)`` logs (static only), ``cache`` holding it by
-    ``key`` (kept on what it is made of, :mod:`astralis_des.memo`). The first time, it is
-    logged as it is; the second time it is prepared (a throwaway recording costs a few ms,
-    not worth it for a one-off run) and sent as chunks from then on."""
-    if key not in cache:
-        cache[key] = None
-    elif cache[key] is None:
-        cache[key] = _prepare(rr, logged)
-    chunks = cache[key]
+    """Send to ``rec`` what ``logged(stream)`` logs (static only). The first time a process
+    sees ``key`` for ``owner`` (the object it is made of, kept with it so that ``key`` may
+    hold its ``id``), it is logged as it is; the second time it is prepared (a throwaway
+    recording costs a few ms, not worth it for a one-off run) and sent as chunks from then
+    on."""
+    kept = _PREPARED.pop(key, None)
+    seen = kept is not None and kept[0] is owner
+    chunks = kept[1] if kept is not None and seen else None
+    if seen and chunks is None:
+        chunks = _prepare(rr, logged)
+    _PREPARED[key] = (owner, chunks)
+    while len(_PREPARED) > KEPT:
+        _PREPARED.popitem(last=False)
     if chunks is None:
         logged(rec)
     else:

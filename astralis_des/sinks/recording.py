@@ -91,8 +91,7 @@ class RerunRecorder:
     def _log_world(self) -> None:
         rr, rec, sim = self.rr, self.rec, self.sim
         world = sim.world
-        send_prepared(rr, rec, world.memo("recorded", 4), "solids",
-                      lambda s: log_solids(rr, s, world))
+        send_prepared(rr, rec, ("solids", id(world)), world, lambda s: log_solids(rr, s, world))
         target = sim.target
         rec.log(paths.WORLD_TARGET, rr.Points3D([target.position], radii=0.3,
                                                 colors=[(255, 0, 255)],
