@@ -23,7 +23,9 @@ What is kept, on what (``kept(owner, NAME)``):
 Elsewhere, once per process and by value (``functools``): the packaged clutter catalogue, the
 ROS 2 message types, a camera's swath by view and height, a catalogue without its furniture,
 a motion's course by path and speed parameters (with the sighting samples along it,
-``kernel.course``), and the built worlds themselves (by file content and the robot kinds
+``kernel.course``), a world's solids as Rerun chunks once recorded twice and a layout's
+blueprint encoded (``sinks.prepared``, ``sinks.blueprint``: not on the world, which a study
+pickles for its workers), and the built worlds themselves (by file content and the robot kinds
 registered).
 
 The registries (kinds, actions, strategies, planners, drivers, looks, event kinds) fill as

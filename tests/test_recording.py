@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import pickle
 import re
 import signal
 import subprocess
@@ -135,6 +136,9 @@ def test_a_mission_run_again_in_one_process_records_the_same(tmp_path: Path) -> 
         kinds.append(kind)
         at += MESSAGE.size + length
     assert kinds.count(3) == 1  # the blueprint's activation
+    # a study sends the mission, world and all, to its workers pickled (Ray): what the runs
+    # prepared for their recordings stays off it (Rerun's chunks cannot be pickled)
+    assert pickle.loads(pickle.dumps(mission)).world.name == mission.world.name
 
 
 def test_one_state_change_per_task_start_and_end(faults_run: tuple[RunResult, Path]) -> None:

@@ -21,6 +21,8 @@ from astralis_des.sinks.blueprint import APPLICATION
 log = logging.getLogger(__name__)
 
 KEPT = 32  # prepared parts a process keeps (the least recently sent go first)
+# Kept here, not on the world (memo.kept): a study sends its world to Ray's workers pickled,
+# and Rerun's chunks cannot be pickled. Keys hold the world's id, the world kept beside them.
 _PREPARED: OrderedDict[Hashable, tuple[Any, list[Any] | None]] = OrderedDict()
 
 
