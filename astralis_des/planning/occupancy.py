@@ -17,7 +17,7 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, partial
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
@@ -157,7 +157,7 @@ class VoxelMap(_FieldGrid):
         if self.layers is None:
             return _Field(self.distance)
         resolution = self.resolution
-        return LayerField(self.layers, lambda cells2: _metres(cells2, resolution))
+        return LayerField(self.layers, partial(_metres, resolution=resolution))  # picklable
 
     def segment_free(self, p0: ArrayLike, p1: ArrayLike, radius: float) -> bool:
         """Is every point of the segment, sampled every half voxel, free for ``radius``?"""
