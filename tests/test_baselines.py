@@ -168,7 +168,7 @@ def test_each_baseline_runs_the_default_mission_the_same_twice(strategy: str,
 
 # -- metrics ---------------------------------------------------------------------------------
 def test_gini_of_workloads() -> None:
-    from astralis_des.studies.eval_metrics import gini
+    from astralis_des.simulation.metrics import gini
 
     assert gini(np.array([2.0, 2.0, 2.0, 2.0])) == 0.0
     assert gini(np.array([0.0, 0.0, 0.0, 4.0])) == pytest.approx(0.75)  # (n - 1) / n
@@ -181,7 +181,7 @@ def test_social_metrics_of_a_robot_passing_a_person() -> None:
     it comes 1.0 m close, and is within 1.2 m while |x| < 0.663 m, for 1.33 s."""
     from types import SimpleNamespace
 
-    from astralis_des.studies.eval_metrics import social
+    from astralis_des.simulation.metrics import social
 
     person = SimpleNamespace(kind="human", trail_t=[0.0, 10.0],
                              trail_p=[np.zeros(3), np.zeros(3)], motion=None, pose=np.zeros(3))
@@ -195,7 +195,7 @@ def test_social_metrics_of_a_robot_passing_a_person() -> None:
 
 
 def test_allocation_metrics_of_the_default_mission_match_its_event_log(tmp_path: Path) -> None:
-    from astralis_des.studies.eval_metrics import allocation_metrics
+    from astralis_des.simulation.metrics import allocation_metrics
 
     mission = load_mission(ROOT / "missions" / "urban_search.yaml")
     sim = Simulation(mission, out_dir=tmp_path)
@@ -204,7 +204,7 @@ def test_allocation_metrics_of_the_default_mission_match_its_event_log(tmp_path:
     searches = [e for e in events if e["kind"] == "task_finished" and e["room"]
                 and e["action"] != "move"
                 and e["status"] == "succeeded"]
-    got = allocation_metrics(sim, result, 0.5, 0.5)
+    got = allocation_metrics(sim, result.rounds, result.end_time, 0.5, 0.5)
     assert got["makespan"] == pytest.approx(max(e["t"] for e in searches), abs=1e-6)
     last = {e["room"]: e["t"] for e in searches}
     assert got["completion_sum"] == pytest.approx(sum(last.values()), abs=1e-5)

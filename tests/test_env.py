@@ -27,7 +27,7 @@ from astralis_des.env import (
     mixed_policy,
     random_policy,
 )
-from astralis_des.studies.eval_mission import search_time
+from astralis_des.simulation.metrics import search_time
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT = ROOT / "missions" / "urban_search.yaml"

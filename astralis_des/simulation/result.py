@@ -6,6 +6,7 @@ from dataclasses import asdict, dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 from astralis_des.kernel.events import Record, plain
+from astralis_des.simulation.metrics import run_metrics
 
 if TYPE_CHECKING:
     from astralis_des.simulation.contracts import Run
@@ -47,6 +48,8 @@ class RunResult:
     wall_time: float = 0.0
     sensor_time: dict[str, float] = field(default_factory=dict)  # wall s per sensor (physics)
     allocation_time: list[float] = field(default_factory=list)  # wall s of each round's plan
+    # the run's metrics (astralis_des.simulation.metrics): summary.json's last entry
+    metrics: dict[str, Any] = field(default_factory=dict)
 
     @property
     def found(self) -> bool:
@@ -82,18 +85,21 @@ def build_result(sim: Run, outcome: str, wall_time: float) -> RunResult:
     rooms = room_report(sim)
     target = {"room": sim.target.room, "position": list(sim.target.position),
               **sim.target.avatar}
+    time_to_find = detection["t"] if detection else None
+    failed = sum(s.tasks_failed for s in stats.values())
     perception = sim.cosim.perception
     clock = perception.clock if perception is not None else None
     return RunResult(
         mission=sim.mission.spec.name, seed=sim.mission.spec.seed,
         fidelity=sim.mission.spec.fidelity, outcome=outcome, end_time=now,
-        time_to_find=detection["t"] if detection else None,
+        time_to_find=time_to_find,
         found_by=detection["robot"] if detection else None, target=target, robots=stats,
         rounds=sim.rounds, rooms_searched=list(sim.searched), coverage=coverage,
         events=sim.log.records, rooms=rooms, wall_time=wall_time,
         sensor_calls=dict(sorted(clock.calls.items())) if clock is not None else {},
         sensor_time=dict(sorted(clock.seconds.items())) if clock is not None else {},
-        allocation_time=list(sim.allocation_time))
+        allocation_time=list(sim.allocation_time),
+        metrics=run_metrics(sim, sim.rounds, now, failed, time_to_find))
 
 
 def room_report(sim: Run) -> dict[str, dict[str, Any]]:

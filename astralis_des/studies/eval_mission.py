@@ -11,13 +11,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from astralis_des.kinds import KINDS
-from astralis_des.studies.eval_metrics import allocation_metrics
 from astralis_des.studies.evaluation import Metric, evaluation
 from astralis_des.studies.teams import renamed_robots, team_ids
 
 if TYPE_CHECKING:
     from astralis_des.mission.loader import Mission
-    from astralis_des.simulation import Simulation
     from astralis_des.studies.draws import Scenario
     from astralis_des.studies.factors import Setting
     from astralis_des.studies.spec import Study, Variant
@@ -87,31 +85,17 @@ def evaluate_mission(study: Study, scenario: Scenario, variant: Variant,
     s = variant.setting
     sim = Simulation(scenario_mission(study, scenario, s, out_dir is not None), out_dir=out_dir)
     result = sim.run()
+    m = result.metrics  # the run's own (summary.json's), in the table's column order
     row: dict[str, Any] = {
-        "outcome": result.outcome, "found": result.found, "time_to_find": result.time_to_find,
+        "outcome": result.outcome, "found": m["found"], "time_to_find": m["time_to_find"],
         "found_by": result.found_by, "end_time": result.end_time,
-        "target_room": result.target["room"], "rooms_searched": len(result.rooms_searched),
-        "rounds": len(result.rounds),
-        "tasks_failed": sum(st.tasks_failed for st in result.robots.values()),
-        "distance": sum(st.distance for st in result.robots.values()),
+        "target_room": result.target["room"], "rooms_searched": m["rooms_searched"],
+        "rounds": len(result.rounds), "tasks_failed": m["tasks_failed"],
+        "distance": m["distance"],
     }
     for kind in KINDS:
         row[f"distance_{kind}"] = sum(st.distance for st in result.robots.values()
                                       if st.kind == kind)
-    high_risk = {r for r, st in sim.rooms.items() if st.risk >= s.high_risk}
-    high_mess = {r for r, st in sim.rooms.items() if st.messiness >= s.high_messiness}
-    row["human_high_risk_s"] = search_time(sim, "human", high_risk)
-    row["ugv_high_mess_s"] = search_time(sim, "ugv", high_mess)
-    row["high_risk_rooms"] = len(high_risk)
-    row["high_mess_rooms"] = len(high_mess)
-    row.update(allocation_metrics(sim, result, s.high_risk, s.high_messiness))
+    firsts = ("found", "time_to_find", "rooms_searched", "tasks_failed", "distance")
+    row.update((k, v) for k, v in m.items() if k not in firsts)
     return row
-
-
-def search_time(sim: Simulation, kind: str, rooms: set[str]) -> float:
-    """Seconds robots of ``kind`` spent searching ``rooms`` (their Table IV actions, however
-    they ended; the way to the door is not counted). A UGV searches from the door or the
-    corridor, so this, not time inside, is what it is exposed to."""
-    return float(sum(res.end - res.start for task, res in sim.finished
-                     if task.room in rooms and task.action != "move"
-                     and sim.robots[task.robot].kind == kind))

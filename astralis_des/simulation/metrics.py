@@ -1,4 +1,13 @@
-"""The metrics of the multi-robot task allocation field, from a finished mission (issue 21).
+"""A finished mission's metrics: ``RunResult.metrics``, written in ``summary.json`` and read
+by the studies (a column each), ``astralis falsify`` and ``astralis diff``.
+
+- ``found``, ``time_to_find``, ``rooms_searched``, ``tasks_failed``, ``distance``: the run's
+  outcome in numbers;
+- ``human_high_risk_s`` and ``ugv_high_mess_s``: seconds people spent searching high-risk rooms
+  and UGVs high-messiness ones (:func:`search_time`; the paper's Table V trade-off), with the
+  counts of such rooms (``high_risk_rooms``, ``high_mess_rooms``);
+
+The metrics of the multi-robot task allocation field (issue 21):
 
 - ``makespan``: when the last search of the run ended (a mission stops when the target is
   seen, so this is the makespan of what was executed, not of the whole plan);
@@ -27,31 +36,57 @@ import numpy as np
 from astralis_des.kinds import KIND_DEFAULTS
 
 if TYPE_CHECKING:
-    from astralis_des.simulation import Simulation
-    from astralis_des.simulation.result import RunResult
+    from astralis_des.simulation.contracts import Run
 
 CLOSE = 1.2  # m: a robot this near a person is too near (HuNavSim)
 STEP = 0.1  # s between the samples of the trails
 MOVING = 0.05  # m/s: slower is standing still
 
 
-def allocation_metrics(sim: Simulation, result: RunResult, high_risk: float,
-                       high_messiness: float) -> dict[str, Any]:
+def run_metrics(sim: Run, rounds: list[dict[str, Any]], end: float,
+                tasks_failed: int, found_at: float | None) -> dict[str, Any]:
+    """The metrics of a finished run, rooms judged high by the mission's thresholds (on the
+    rooms' values at the end of the run)."""
+    cfg = sim.mission.spec.assignment
+    high_risk = {r for r, st in sim.rooms.items() if st.risk >= cfg.high_risk}
+    high_mess = {r for r, st in sim.rooms.items() if st.messiness >= cfg.high_messiness}
+    return {
+        "found": found_at is not None, "time_to_find": found_at,
+        "rooms_searched": len(sim.searched), "tasks_failed": tasks_failed,
+        "distance": sum(r.distance for r in sim.robots.values()),
+        "human_high_risk_s": search_time(sim, "human", high_risk),
+        "ugv_high_mess_s": search_time(sim, "ugv", high_mess),
+        "high_risk_rooms": len(high_risk), "high_mess_rooms": len(high_mess),
+        **allocation_metrics(sim, rounds, end, cfg.high_risk, cfg.high_messiness),
+    }
+
+
+def search_time(sim: Run, kind: str, rooms: set[str]) -> float:
+    """Seconds robots of ``kind`` spent searching ``rooms`` (their Table IV actions, however
+    they ended; the way to the door is not counted). A UGV searches from the door or the
+    corridor, so this, not time inside, is what it is exposed to."""
+    return float(sum(res.end - res.start for task, res in sim.finished
+                     if task.room in rooms and task.action != "move"
+                     and sim.robots[task.robot].kind == kind))
+
+
+def allocation_metrics(sim: Run, rounds: list[dict[str, Any]], end: float,
+                       high_risk: float, high_messiness: float) -> dict[str, Any]:
     searches = [(task, res) for task, res in sim.finished
                 if task.room and task.action != "move" and res.ok]
     ends = {task.room: res.end for task, res in searches}
     counts = np.array([sum(1 for task, _ in searches if task.robot == rid)
                        for rid in sim.robots], dtype=float)
-    human, ugv = _round_shares(sim, result.rounds, high_risk, high_messiness)
+    human, ugv = _round_shares(sim, rounds, high_risk, high_messiness)
     return {
         "makespan": max((res.end for _, res in searches), default=None),
         "completion_sum": float(sum(ends.values())) if ends else None,
-        "infeasible_rounds": sum(1 for r in result.rounds if r.get("info", {}).get("infeasible")),
+        "infeasible_rounds": sum(1 for r in rounds if r.get("info", {}).get("infeasible")),
         "rooms_per_robot": float(counts.mean()) if len(counts) else 0.0,
         "workload_gini": gini(counts),
         "human_high_risk_rounds": human,
         "ugv_high_mess_rounds": ugv,
-        **social(sim, result.end_time),
+        **social(sim, end),
     }
 
 
@@ -65,7 +100,7 @@ def gini(values: np.ndarray) -> float:
     return float((2 * (ranks * v).sum()) / (n * total) - (n + 1) / n)
 
 
-def _round_shares(sim: Simulation, rounds: list[dict[str, Any]], high_risk: float,
+def _round_shares(sim: Run, rounds: list[dict[str, Any]], high_risk: float,
                   high_messiness: float) -> tuple[float | None, float | None]:
     """Shares of the rounds with an agent in a room high in its hazard: a person in a
     high-risk room, a UGV in a high-messiness one (None where the team has no agent with that
@@ -85,7 +120,7 @@ def _round_shares(sim: Simulation, rounds: list[dict[str, Any]], high_risk: floa
     return shares[0], shares[1]
 
 
-def social(sim: Simulation, end: float) -> dict[str, float | None]:
+def social(sim: Run, end: float) -> dict[str, float | None]:
     """The closest approach of a moving robot to a person, and seconds within ``CLOSE``."""
     people = [rid for rid, r in sim.robots.items() if KIND_DEFAULTS[r.kind].person]
     others = [rid for rid, r in sim.robots.items() if not KIND_DEFAULTS[r.kind].person]
@@ -107,7 +142,7 @@ def social(sim: Simulation, end: float) -> dict[str, float | None]:
             "human_close_s": close}
 
 
-def _track(sim: Simulation, rid: str, times: np.ndarray, end: float) -> np.ndarray:
+def _track(sim: Run, rid: str, times: np.ndarray, end: float) -> np.ndarray:
     """Where robot ``rid`` was at ``times``, from its trail (and a motion still under way)."""
     robot = sim.robots[rid]
     t = list(robot.trail_t)
