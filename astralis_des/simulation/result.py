@@ -48,7 +48,8 @@ class RunResult:
     wall_time: float = 0.0
     sensor_time: dict[str, float] = field(default_factory=dict)  # wall s per sensor (physics)
     allocation_time: list[float] = field(default_factory=list)  # wall s of each round's plan
-    # the run's metrics (astralis_des.simulation.metrics): summary.json's last entry
+    # the run's metrics (astralis_des.simulation.metrics): summary.json's last entry, where
+    # floats are rounded to 1e-6 as everywhere in it (``plain(metrics)`` is what it holds)
     metrics: dict[str, Any] = field(default_factory=dict)
 
     @property
