@@ -90,7 +90,22 @@ def _print_summary(console: Any, result: RunResult, out: Path) -> None:
     console.print(table)
     if not result.found:
         _print_rooms(console, result)
+    console.print(_metrics_line(result.metrics))
     console.print(f"outputs: {out}/")
+
+
+# the metrics the run's summary line names (all are in summary.json's ``metrics``)
+SHOWN = (("human_high_risk_s", "human searching high-risk rooms", "{:.1f} s"),
+         ("ugv_high_mess_s", "UGV searching high-messiness rooms", "{:.1f} s"),
+         ("tasks_failed", "failed tasks", "{}"),
+         ("makespan", "makespan", "{:.1f} s"),
+         ("human_min_distance", "closest moving robot to a person", "{:.2f} m"))
+
+
+def _metrics_line(metrics: dict[str, Any]) -> str:
+    shown = [f"{label} {fmt.format(metrics[key])}" for key, label, fmt in SHOWN
+             if metrics.get(key) is not None]
+    return "metrics (summary.json has them all): " + "; ".join(shown)
 
 
 def _print_rooms(console: Any, result: RunResult) -> None:
