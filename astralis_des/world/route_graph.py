@@ -9,17 +9,14 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
 from astralis_des.kinds import KIND_DEFAULTS, KINDS, KindDefaults
 from astralis_des.world.geometry import FloatArray, segments_hit_boxes
 from astralis_des.world.interior_routes import reflex_corners, side_of, visible
-from astralis_des.world.parts import BLOCK, Building
-
-if TYPE_CHECKING:
-    from astralis_des.world.routing import Site
+from astralis_des.world.parts import BLOCK, Building, InteriorPlan, Room, Solid, Space
 
 OUTDOOR_MARGIN = 1.0  # how far outside a footprint corner the outdoor route turns
 STAIR_RUN_FACTOR = 2.0  # horizontal run of a flight of stairs per metre of rise
@@ -29,6 +26,29 @@ WALL_HALF = 0.15  # m: half a found wall (a door's centre is in its middle)
 # Not outdoor blockers: walls and slabs are inside footprints, and an imported world's blocks
 # (thousands) are left to the navigator, which flies or walks round them on a grid.
 NOT_BLOCKERS = ("wall", "slab", BLOCK)
+
+
+class Site(Protocol):
+    """What routing needs of a world (:class:`~astralis_des.world.model.World` is one)."""
+
+    @property
+    def buildings(self) -> dict[str, Building]: ...
+    @property
+    def rooms(self) -> dict[str, Room]: ...
+    @property
+    def spaces(self) -> dict[str, Space]: ...
+    @property
+    def solids(self) -> tuple[Solid, ...]: ...
+    @property
+    def block_array(self) -> FloatArray: ...
+    @property
+    def areas(self) -> list[Room]: ...
+    @property
+    def stairs_passable_by(self) -> dict[str, tuple[str, ...]]: ...
+    @property
+    def interior(self) -> InteriorPlan | None: ...
+    def contains(self, point: tuple[float, ...] | FloatArray) -> bool: ...
+    def room_at(self, point: tuple[float, ...] | FloatArray) -> Room | None: ...
 
 
 class GraphBuilder:

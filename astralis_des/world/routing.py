@@ -9,7 +9,7 @@ the rows routes leave from are searched (the same rows), so routes are the same.
 from __future__ import annotations
 
 from collections import OrderedDict
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -20,36 +20,12 @@ from astralis_des.kinds import KINDS
 from astralis_des.memo import kept
 from astralis_des.world.geometry import FloatArray, boxes_array
 from astralis_des.world.interior_routes import visible
-from astralis_des.world.parts import Building, InteriorPlan, Room, Solid, Space
-from astralis_des.world.route_graph import GraphBuilder
+from astralis_des.world.route_graph import GraphBuilder, Site
 
 SNAP = 0.5  # m: a point this close to a room or corridor (in a wall, by a door) belongs to it
 CACHE_BYTES = 256_000_000  # of searched rows kept (12 B a node each): every row of a world of
 # 1,000 rooms, 600 of one of 10,000
 ROUTES_KEPT = 8192  # routes kept (a few waypoints each), and places of points
-
-
-class Site(Protocol):
-    """What routing needs of a world (:class:`~astralis_des.world.model.World` is one)."""
-
-    @property
-    def buildings(self) -> dict[str, Building]: ...
-    @property
-    def rooms(self) -> dict[str, Room]: ...
-    @property
-    def spaces(self) -> dict[str, Space]: ...
-    @property
-    def solids(self) -> tuple[Solid, ...]: ...
-    @property
-    def block_array(self) -> FloatArray: ...
-    @property
-    def areas(self) -> list[Room]: ...
-    @property
-    def stairs_passable_by(self) -> dict[str, tuple[str, ...]]: ...
-    @property
-    def interior(self) -> InteriorPlan | None: ...
-    def contains(self, point: tuple[float, ...] | FloatArray) -> bool: ...
-    def room_at(self, point: tuple[float, ...] | FloatArray) -> Room | None: ...
 
 
 class Router(GraphBuilder):
