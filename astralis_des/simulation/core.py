@@ -25,6 +25,7 @@ from astralis_des.kernel.handler import TaskHandler
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import ActionResult, Stop, Task, TaskStatus
 from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.mission.changes import Changes
 from astralis_des.mission.draws import draw_rooms, draw_target
 from astralis_des.mission.loader import Mission
 from astralis_des.mission.spec import MemberSpec
@@ -32,6 +33,7 @@ from astralis_des.navsensors import BodySamples, PoseSensors, motion_poses
 from astralis_des.planning.navigator import Navigator
 from astralis_des.plugins import SENSORS, check_params
 from astralis_des.sensing import GeometricSensor, Sighting
+from astralis_des.simulation.fork import ForkPoint, prepare, whole_run
 from astralis_des.simulation.outputs import OUTPUTS
 from astralis_des.simulation.result import RunResult, build_result
 from astralis_des.simulation.timeline import scheduled, search
@@ -291,6 +293,16 @@ class Simulation:
         finally:
             result = self.finish()
         return result
+
+    def fork(self, at: str | ForkPoint, changes: Changes) -> RunResult:
+        """Run as ``run()`` does up to the fork point ``at`` (``round:N``, ``event:N`` or
+        ``time:T``), then make ``changes`` (``{KEY: value}`` or ``"KEY=VALUE"`` strings, as
+        ``astralis run --set``) and run on (docs/howto/fork.md). A point the run never
+        reaches raises :class:`~astralis_des.simulation.fork.ForkNotReached`, the run in it."""
+        fork = prepare(self.mission, at, changes)
+        self.mission = whole_run(self.mission, fork)
+        self._searcher = fork.searcher(self, self._searcher)
+        return fork.run(self)
 
     def start(self) -> None:
         """Open the outputs and start the timeline; ``advance`` then moves time on."""
