@@ -33,7 +33,7 @@ from astralis_des.navsensors import BodySamples, PoseSensors, motion_poses
 from astralis_des.planning.navigator import Navigator
 from astralis_des.plugins import SENSORS, check_params
 from astralis_des.sensing import GeometricSensor, Sighting
-from astralis_des.simulation.fork import ForkPoint, prepare, whole_run
+from astralis_des.simulation.fork import ForkPoint, prepare
 from astralis_des.simulation.outputs import OUTPUTS
 from astralis_des.simulation.result import RunResult, build_result
 from astralis_des.simulation.timeline import scheduled, search
@@ -60,7 +60,7 @@ class Simulation:
                  searcher: Searcher | None = None) -> None:
         spec = mission.spec
         self.view = view  # also stream the recording to a spawned Rerun viewer
-        self._searcher = searcher or search  # the process that decides the rounds
+        self.searcher = searcher or search  # the process that decides the rounds
         self._held: list[tuple[str, str, str]] = []
         self._end: simpy.Event | None = None
         self.mission = mission
@@ -299,10 +299,7 @@ class Simulation:
         ``time:T``), then make ``changes`` (``{KEY: value}`` or ``"KEY=VALUE"`` strings, as
         ``astralis run --set``) and run on (docs/howto/fork.md). A point the run never
         reaches raises :class:`~astralis_des.simulation.fork.ForkNotReached`, the run in it."""
-        fork = prepare(self.mission, at, changes)
-        self.mission = whole_run(self.mission, fork)
-        self._searcher = fork.searcher(self, self._searcher)
-        return fork.run(self)
+        return prepare(self.mission, at, changes).run(self)
 
     def start(self) -> None:
         """Open the outputs and start the timeline; ``advance`` then moves time on."""
@@ -323,7 +320,7 @@ class Simulation:
                       team=[m.id for m in spec.team])
         ends = [self.found]
         if spec.assignment.auto:  # else the rounds come from commands (the API's assign)
-            self._timeline = self.env.process(self._searcher(self))
+            self._timeline = self.env.process(self.searcher(self))
             ends.append(self._timeline)
         for event in spec.timeline:
             self.env.process(scheduled(self, event))

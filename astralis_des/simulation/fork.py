@@ -135,6 +135,11 @@ class Fork:
     def run(self, sim: Simulation) -> RunResult:
         """Run ``sim`` to its end through the fork point; raise :class:`ForkNotReached` (the
         result in it) if the run ended before it."""
+        if sim.started:
+            raise ValueError("a fork runs a simulation from its start: this one has started")
+        self.record, self.passed = None, False
+        sim.mission = whole_run(sim.mission, self)
+        sim.searcher = self.searcher(sim, sim.searcher)
         try:  # as Simulation.run: an interrupt while starting still ends the outputs
             TRIGGERS.get(self.point.kind).reach(self, sim)
             sim.advance()
@@ -147,7 +152,7 @@ class Fork:
     def _missed(self, result: RunResult) -> str:
         return (f"{self.point} was never reached: the run ended ({result.outcome}) at t = "
                 f"{result.end_time:.1f} s after {len(result.rounds)} rounds and "
-                f"{len(result.events)} events, the run unchanged")
+                f"{len(result.events)} events; the run went on unchanged")
 
     def apply(self, sim: Simulation, *, now: bool = True) -> None:
         """Fork here: the mission's changes in place, a ``fork`` event, the events added to
@@ -307,7 +312,7 @@ def _fork_time(mission: Mission, fork: Fork) -> float | None:
 
     probe = replace(fork, probe=True)
     sim = Simulation(mission)
-    sim._searcher = probe.searcher(sim, sim._searcher)  # its own package's
+    sim.searcher = probe.searcher(sim, sim.searcher)
     try:
         TRIGGERS.get(probe.point.kind).reach(probe, sim)
         sim.advance()
