@@ -27,6 +27,7 @@ def run_command(args: argparse.Namespace) -> int:
         from astralis_des.simulation.fork import prepare
 
         fork = prepare(mission, args.fork_at, args.set)
+        fork.check_times(Simulation)
     if args.view:
         from astralis_des.sinks.viewer import require_display
 
@@ -40,7 +41,7 @@ def run_command(args: argparse.Namespace) -> int:
 
     def run(progress: Any) -> RunResult:
         made.append(Simulation(mission, out_dir=out, progress=progress, view=args.view))
-        return made[0].run() if fork is None else fork.run(made[0])
+        return made[0].run() if fork is None else fork.run(made[0], Simulation)
 
     try:
         with holding(out):  # a second writer is refused before the world is built

@@ -299,7 +299,7 @@ class Simulation:
         ``time:T``), then make ``changes`` (``{KEY: value}`` or ``"KEY=VALUE"`` strings, as
         ``astralis run --set``) and run on (docs/howto/fork.md). A point the run never
         reaches raises :class:`~astralis_des.simulation.fork.ForkNotReached`, the run in it."""
-        return prepare(self.mission, at, changes).run(self)
+        return prepare(self.mission, at, changes).run(self, Simulation)
 
     def start(self) -> None:
         """Open the outputs and start the timeline; ``advance`` then moves time on."""

@@ -23,9 +23,9 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from functools import partial
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from astralis_des.errors import InputError
 from astralis_des.kernel.events import Record
@@ -40,12 +40,16 @@ from astralis_des.mission.changes import (
 )
 from astralis_des.mission.spec import RoomChangeEvent
 from astralis_des.registry import Registry
+from astralis_des.simulation.contracts import Run
 from astralis_des.simulation.timeline import TIMELINE_EVENTS, scheduled, search
 from astralis_des.yamlio import format_path
 
 if TYPE_CHECKING:
+    from collections.abc import Generator
+
+    import simpy
+
     from astralis_des.mission.loader import Mission
-    from astralis_des.simulation.core import Searcher, Simulation
     from astralis_des.simulation.result import RunResult
 
 Leaf = tuple[tuple[Any, ...], Any]  # a changed key of the mission file, and its new value
@@ -57,6 +61,22 @@ WHOLE_RUN = (("outputs",),)  # what the run writes: from its start, fork or not
 ROOMS = ("rooms", "set")
 ALLOWED = ("at a fork only the assignment settings, rooms.set and events appended with "
            "timeline+= change (docs/howto/fork.md); from the start (no fork) any key does")
+
+
+Searcher = Callable[[Any], "Generator[simpy.Event, Any, str]"]
+
+
+class Simulation(Run, Protocol):
+    """What a fork sees of the run it forks (:class:`~astralis_des.simulation.Simulation`)."""
+
+    mission: Mission  # a fork changes it mid-run
+    searcher: Searcher
+
+    @property
+    def started(self) -> bool: ...
+
+    def advance(self, until: float | None = None) -> bool: ...
+    def finish(self) -> RunResult: ...
 
 
 class ForkNotReached(InputError):
@@ -115,7 +135,10 @@ class Fork:
     changes: dict[str, Any]  # the keys changed mid-run (as --set spells them), new values
     added: list[tuple[Any, bool]]  # timeline events to add, and whether at the fork (``at``
     # left out: its value is only a placeholder)
+    original: Mission | None = None  # the mission it forks
+    said: list[Change] = field(default_factory=list)  # the changes as given, for errors
     probe: bool = False  # only find the fork's time (a fork with events at given times)
+    timed: bool = False  # the events added at given times are checked against the fork's
     record: Record | None = None
     passed: bool = False  # the run had ended when it came to the point
 
@@ -132,11 +155,13 @@ class Fork:
         if len(sim.rounds) + 1 >= self.point.value:
             self.apply(sim)
 
-    def run(self, sim: Simulation) -> RunResult:
+    def run(self, sim: Simulation, make: Callable[[Mission], Simulation]) -> RunResult:
         """Run ``sim`` to its end through the fork point; raise :class:`ForkNotReached` (the
-        result in it) if the run ended before it."""
+        result in it) if the run ended before it. ``make`` builds a run of a mission (the
+        ``Simulation`` class), to time the fork when events are added at given times."""
         if sim.started:
             raise ValueError("a fork runs a simulation from its start: this one has started")
+        self.check_times(make)
         self.record, self.passed = None, False
         sim.mission = whole_run(sim.mission, self)
         sim.searcher = self.searcher(sim, sim.searcher)
@@ -148,6 +173,25 @@ class Fork:
         if self.record is None:
             raise ForkNotReached(self._missed(result), result)
         return result
+
+    def check_times(self, make: Callable[[Mission], Simulation] | None) -> None:
+        """Refuse (one line) an event added at a given time before the fork. At a time fork
+        that is known at once; at a round or an event it takes a run of the original to the
+        fork point, without outputs (``make`` builds it: ``Simulation``)."""
+        timed = [(i, e.at) for i, (e, at_fork) in enumerate(self.added) if not at_fork]
+        if self.timed or not timed or self.original is None:
+            return
+        if self.point.kind == "time":
+            when: float | None = self.point.value
+        else:
+            assert make is not None, "a round or an event fork is timed by a run"
+            when = _fork_time(self, make(self.original))
+        kept = len(self.original.spec.timeline)
+        for i, at in timed:
+            if when is not None and at < when - 1e-9:
+                raise blame(self.said, f"timeline[{kept + i}].at", f"{at:g} s is before the "
+                            f"fork ({self.point} comes at t = {when:.6g} s)")
+        self.timed = True
 
     def _missed(self, result: RunResult) -> str:
         return (f"{self.point} was never reached: the run ended ({result.outcome}) at t = "
@@ -244,8 +288,10 @@ def prepare(mission: Mission, at: str | ForkPoint, changes: Changes) -> Fork:
                     "timeline at a fork")
     added = [*zip(changed.spec.timeline[kept:], at_fork, strict=True),
              *((e, True) for e in _room_changes(leaves))]
-    fork = Fork(point, changed, {show_path(p): v for p, v in leaves if _mid_run(p)}, added)
-    _check_times(fork, mission, parsed)
+    fork = Fork(point, changed, {show_path(p): v for p, v in leaves if _mid_run(p)}, added,
+                mission, parsed)
+    if point.kind == "time":
+        fork.check_times(None)
     return fork
 
 
@@ -290,28 +336,10 @@ def _room_changes(leaves: list[Leaf]) -> list[RoomChangeEvent]:
             for room, values in props.items()]
 
 
-def _check_times(fork: Fork, mission: Mission, changes: list[Change]) -> None:
-    """An event added at a given time must not come before the fork: at a time fork that is
-    seen here; at a round or an event it takes running the mission to the fork (no outputs)."""
-    timed = [(i, e.at) for i, (e, at_fork) in enumerate(fork.added) if not at_fork]
-    if not timed:
-        return
-    when = fork.point.value if fork.point.kind == "time" else _fork_time(mission, fork)
-    if when is None:
-        return  # never reached: the run says so
-    kept = len(mission.spec.timeline)
-    for i, at in timed:
-        if at < when - 1e-9:
-            raise blame(changes, f"timeline[{kept + i}].at", f"{at:g} s is before the fork "
-                        f"({fork.point} comes at t = {when:.6g} s)")
-
-
-def _fork_time(mission: Mission, fork: Fork) -> float | None:
-    """The simulated time the run comes to the fork point, or None if it never does."""
-    from astralis_des.simulation.core import Simulation
-
+def _fork_time(fork: Fork, sim: Simulation) -> float | None:
+    """The simulated time ``sim`` (a run of the original, without outputs) comes to the fork
+    point, or None if it never does."""
     probe = replace(fork, probe=True)
-    sim = Simulation(mission)
     sim.searcher = probe.searcher(sim, sim.searcher)
     try:
         TRIGGERS.get(probe.point.kind).reach(probe, sim)
