@@ -79,6 +79,18 @@ def test_the_log_before_the_fork_is_the_original_byte_for_byte(
     assert summary["fork"] == fork == result.fork
 
 
+def test_a_fork_that_changes_nothing_goes_on_as_the_original(
+        urban_search: Mission, original: tuple[Path, RunResult], tmp_path: Path) -> None:
+    """Replay is exact: the weights set to their own values, the log is the original's but
+    for the fork line (the mission as the fork rebuilds it runs as the file does)."""
+    Simulation(quiet(urban_search), out_dir=tmp_path).fork(
+        "time:60", {"assignment.weights.risk.human": 10.0})
+    forked = lines(tmp_path)
+    k = fork_line(tmp_path)
+    assert json.loads(forked[k])["changes"] == {}
+    assert forked[:k] + forked[k + 1:] == lines(original[0])
+
+
 def test_a_run_without_a_fork_has_none_in_its_summary(original: tuple[Path, RunResult]) -> None:
     summary = json.loads((original[0] / "summary.json").read_text(encoding="utf-8"))
     assert "fork" not in summary
