@@ -66,7 +66,7 @@ ALLOWED = ("at a fork only the assignment settings, rooms.set and events appende
 Searcher = Callable[[Any], "Generator[simpy.Event, Any, str]"]
 
 
-class Simulation(Run, Protocol):
+class ForkedRun(Run, Protocol):
     """What a fork sees of the run it forks (:class:`~astralis_des.simulation.Simulation`)."""
 
     mission: Mission  # a fork changes it mid-run
@@ -108,7 +108,8 @@ class ForkPoint:
         return cls(kind, float(number))
 
     def __str__(self) -> str:
-        return f"{self.kind}:{self.value:g}"
+        number = f"{self.value:.6f}".rstrip("0").rstrip(".")
+        return f"{self.kind}:{number}"
 
 
 @dataclass(frozen=True)
@@ -119,7 +120,7 @@ class Trigger:
     symbol: str  # N or T, for the messages
     number: str
     whole: bool  # a count (round, event), not a time
-    reach: Callable[[Fork, Simulation], None]
+    reach: Callable[[Fork, ForkedRun], None]
 
 
 TRIGGERS: Registry[str, Trigger] = Registry("fork point")
@@ -142,7 +143,7 @@ class Fork:
     record: Record | None = None
     passed: bool = False  # the run had ended when it came to the point
 
-    def searcher(self, sim: Simulation, base: Searcher) -> Searcher:
+    def searcher(self, sim: ForkedRun, base: Searcher) -> Searcher:
         """The search process ``sim`` runs: at a round fork, the mission's own, which asks
         the fork before each round."""
         if self.point.kind != "round":
@@ -151,11 +152,11 @@ class Fork:
             raise ValueError("a fork at a round needs the mission's own search process")
         return partial(search, before_round=partial(self._before_round, sim))
 
-    def _before_round(self, sim: Simulation) -> None:
+    def _before_round(self, sim: ForkedRun) -> None:
         if len(sim.rounds) + 1 >= self.point.value:
             self.apply(sim)
 
-    def run(self, sim: Simulation, make: Callable[[Mission], Simulation]) -> RunResult:
+    def run(self, sim: ForkedRun, make: Callable[[Mission], ForkedRun]) -> RunResult:
         """Run ``sim`` to its end through the fork point; raise :class:`ForkNotReached` (the
         result in it) if the run ended before it. ``make`` builds a run of a mission (the
         ``Simulation`` class), to time the fork when events are added at given times."""
@@ -174,7 +175,7 @@ class Fork:
             raise ForkNotReached(self._missed(result), result)
         return result
 
-    def check_times(self, make: Callable[[Mission], Simulation] | None) -> None:
+    def check_times(self, make: Callable[[Mission], ForkedRun] | None) -> None:
         """Refuse (one line) an event added at a given time before the fork. At a time fork
         that is known at once; at a round or an event it takes a run of the original to the
         fork point, without outputs (``make`` builds it: ``Simulation``)."""
@@ -198,7 +199,7 @@ class Fork:
                 f"{result.end_time:.1f} s after {len(result.rounds)} rounds and "
                 f"{len(result.events)} events; the run went on unchanged")
 
-    def apply(self, sim: Simulation, *, now: bool = True) -> None:
+    def apply(self, sim: ForkedRun, *, now: bool = True) -> None:
         """Fork here: the mission's changes in place, a ``fork`` event, the events added to
         the timeline (those due now at once, unless ``now`` is false: a fork inside another
         process's step schedules them for the same time)."""
@@ -232,11 +233,11 @@ class _Reached(Exception):  # a probe's stop at the fork, not an error
 
 
 # -- the fork points -------------------------------------------------------------------------
-def _reach_round(fork: Fork, sim: Simulation) -> None:
+def _reach_round(fork: Fork, sim: ForkedRun) -> None:
     """Round N: the search asks the fork before each round (:meth:`Fork.searcher`)."""
 
 
-def _reach_event(fork: Fork, sim: Simulation) -> None:
+def _reach_event(fork: Fork, sim: ForkedRun) -> None:
     """Line N: a watcher of the event log, called once every sink has the line."""
     def watch(record: Record) -> None:
         if len(sim.log.records) >= fork.point.value:
@@ -246,7 +247,7 @@ def _reach_event(fork: Fork, sim: Simulation) -> None:
     sim.log.watchers.append(watch)
 
 
-def _reach_time(fork: Fork, sim: Simulation) -> None:
+def _reach_time(fork: Fork, sim: ForkedRun) -> None:
     """Time T: the run advances to T (every event before it), forks, and goes on."""
     if not sim.advance(until=fork.point.value):
         fork.apply(sim)
@@ -336,7 +337,7 @@ def _room_changes(leaves: list[Leaf]) -> list[RoomChangeEvent]:
             for room, values in props.items()]
 
 
-def _fork_time(fork: Fork, sim: Simulation) -> float | None:
+def _fork_time(fork: Fork, sim: ForkedRun) -> float | None:
     """The simulated time ``sim`` (a run of the original, without outputs) comes to the fork
     point, or None if it never does."""
     probe = replace(fork, probe=True)
