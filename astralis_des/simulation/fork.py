@@ -101,11 +101,16 @@ class ForkPoint:
             raise InputError(f"give round:N, event:N or time:T (got {text!r})",
                              key="--fork-at")
         trigger = TRIGGERS.get(kind)
-        pattern = r"[0-9]+" if trigger.whole else r"[0-9]+(\.[0-9]*)?|\.[0-9]+"
-        if not re.fullmatch(pattern, number.strip()) or (trigger.whole and int(number) < 1):
+        pattern = r"[0-9]+(\.[0-9]*)?|\.[0-9]+" if trigger.timed else r"[0-9]+"
+        if not re.fullmatch(pattern, number.strip()) or (
+                not trigger.timed and int(number) < 1):
             raise InputError(f"{kind}:{trigger.symbol} takes {trigger.number} (got {text!r})",
                              key="--fork-at")
         return cls(kind, float(number))
+
+    @property
+    def trigger(self) -> Trigger:
+        return TRIGGERS.get(self.kind)
 
     def __str__(self) -> str:
         number = f"{self.value:.6f}".rstrip("0").rstrip(".")
@@ -119,7 +124,8 @@ class Trigger:
 
     symbol: str  # N or T, for the messages
     number: str
-    whole: bool  # a count (round, event), not a time
+    timed: bool  # its number is the fork's time (a count of rounds or lines, else)
+    asked: bool  # the search asks it before each round (Fork.searcher)
     reach: Callable[[Fork, ForkedRun], None]
 
 
@@ -143,10 +149,14 @@ class Fork:
     record: Record | None = None
     passed: bool = False  # the run had ended when it came to the point
 
+    @property
+    def trigger(self) -> Trigger:
+        return self.point.trigger
+
     def searcher(self, sim: ForkedRun, base: Searcher) -> Searcher:
         """The search process ``sim`` runs: at a round fork, the mission's own, which asks
         the fork before each round."""
-        if self.point.kind != "round":
+        if not self.trigger.asked:
             return base
         if base is not search:
             raise ValueError("a fork at a round needs the mission's own search process")
@@ -167,7 +177,7 @@ class Fork:
         sim.mission = whole_run(sim.mission, self)
         sim.searcher = self.searcher(sim, sim.searcher)
         try:  # as Simulation.run: an interrupt while starting still ends the outputs
-            TRIGGERS.get(self.point.kind).reach(self, sim)
+            self.point.trigger.reach(self, sim)
             sim.advance()
         finally:
             result = sim.finish()
@@ -182,7 +192,7 @@ class Fork:
         timed = [(i, e.at) for i, (e, at_fork) in enumerate(self.added) if not at_fork]
         if self.timed or not timed or self.original is None:
             return
-        if self.point.kind == "time":
+        if self.trigger.timed:
             when: float | None = self.point.value
         else:
             assert make is not None, "a round or an event fork is timed by a run"
@@ -253,10 +263,12 @@ def _reach_time(fork: Fork, sim: ForkedRun) -> None:
         fork.apply(sim)
 
 
-TRIGGERS.register("round")(Trigger("N", "a round number from 1", True, _reach_round))
-TRIGGERS.register("event")(Trigger("N", "a line number of the event log from 1", True,
-                                   _reach_event))
-TRIGGERS.register("time")(Trigger("T", "simulated seconds", False, _reach_time))
+TRIGGERS.register("round")(Trigger("N", "a round number from 1", timed=False, asked=True,
+                                   reach=_reach_round))
+TRIGGERS.register("event")(Trigger("N", "a line number of the event log from 1", timed=False,
+                                   asked=False, reach=_reach_event))
+TRIGGERS.register("time")(Trigger("T", "simulated seconds", timed=True, asked=False,
+                                  reach=_reach_time))
 
 
 # -- a fork checked before the run -----------------------------------------------------------
@@ -265,7 +277,7 @@ def prepare(mission: Mission, at: str | ForkPoint, changes: Changes) -> Fork:
     that cannot be made mid-run, or an event added before the fork, is one-line bad input."""
     point = at if isinstance(at, ForkPoint) else ForkPoint.parse(at)
     limit = mission.spec.time_limit
-    if point.kind == "time" and point.value >= limit:
+    if point.trigger.timed and point.value >= limit:
         raise InputError(f"{point} is not before the mission's time_limit ({limit:g} s): "
                          "the run would end first", key="--fork-at")
     parsed = parse_changes(changes)
@@ -279,7 +291,7 @@ def prepare(mission: Mission, at: str | ForkPoint, changes: Changes) -> Fork:
     at_fork = [isinstance(e, dict) and e.get("at") is None for e in new]
     for event, now in zip(new, at_fork, strict=True):
         if now:  # a placeholder for the check: the fork's time when it comes
-            event["at"] = point.value if point.kind == "time" else 0.0
+            event["at"] = point.value if point.trigger.timed else 0.0
     changed = check_changed(mission, data, parsed)
     after = changed.spec.model_dump(mode="json")
     leaves = _diff(before, after)
@@ -291,7 +303,7 @@ def prepare(mission: Mission, at: str | ForkPoint, changes: Changes) -> Fork:
              *((e, True) for e in _room_changes(leaves))]
     fork = Fork(point, changed, {show_path(p): v for p, v in leaves if _mid_run(p)}, added,
                 mission, parsed)
-    if point.kind == "time":
+    if point.trigger.timed:
         fork.check_times(None)
     return fork
 
@@ -343,7 +355,7 @@ def _fork_time(fork: Fork, sim: ForkedRun) -> float | None:
     probe = replace(fork, probe=True)
     sim.searcher = probe.searcher(sim, sim.searcher)
     try:
-        TRIGGERS.get(probe.point.kind).reach(probe, sim)
+        probe.point.trigger.reach(probe, sim)
         sim.advance()
     except _Reached as reached:
         return reached.t
