@@ -145,7 +145,7 @@ class Fork:
     original: Mission | None = None  # the mission it forks
     said: list[Change] = field(default_factory=list)  # the changes as given, for errors
     probe: bool = False  # only find the fork's time (a fork with events at given times)
-    timed: bool = False  # the events added at given times are checked against the fork's
+    times_checked: bool = False  # the events added at given times, against the fork's
     record: Record | None = None
     passed: bool = False  # the run had ended when it came to the point
 
@@ -190,7 +190,7 @@ class Fork:
         that is known at once; at a round or an event it takes a run of the original to the
         fork point, without outputs (``make`` builds it: ``Simulation``)."""
         timed = [(i, e.at) for i, (e, at_fork) in enumerate(self.added) if not at_fork]
-        if self.timed or not timed or self.original is None:
+        if self.times_checked or not timed or self.original is None:
             return
         if self.trigger.timed:
             when: float | None = self.point.value
@@ -202,7 +202,7 @@ class Fork:
             if when is not None and at < when - 1e-9:
                 raise blame(self.said, f"timeline[{kept + i}].at", f"{at:g} s is before the "
                             f"fork ({self.point} comes at t = {when:.6g} s)")
-        self.timed = True
+        self.times_checked = True
 
     def _missed(self, result: RunResult) -> str:
         return (f"{self.point} was never reached: the run ended ({result.outcome}) at t = "
