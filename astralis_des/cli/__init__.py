@@ -65,6 +65,13 @@ def _parser() -> argparse.ArgumentParser:
     add_quiet(run, "no progress bar or summary table")
     run.add_argument("--view", action="store_true", help="also stream the recording to a "
                      "Rerun viewer it spawns (needs a display)")
+    run.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                     help="change the mission: KEY a dotted path of the file "
+                     "(assignment.strategy, rooms.set[A.1.2.1].risk), VALUE YAML; KEY+=VALUE "
+                     "appends to a list (timeline+={event: fault, robot: uav2}); repeatable")
+    run.add_argument("--fork-at", metavar="round:N|event:N|time:T",
+                     help="run the mission as it is up to this point, then with the --set "
+                     "changes (default output folder: out/<mission name>-fork)")
     replay = sub.add_parser("replay", help="open a run's recording in the Rerun viewer",
                             description="Opens the Rerun viewer on a recording; it needs a "
                             "display. Without one (a server, ssh), --web serves the viewer to "

@@ -22,6 +22,12 @@ def run_command(args: argparse.Namespace) -> int:
     from astralis_des.simulation import Simulation
 
     mission, out = mission_from_args(args)
+    fork = None
+    if args.fork_at is not None:  # checked before the outputs open: bad input writes nothing
+        from astralis_des.simulation.fork import prepare
+
+        fork = prepare(mission, args.fork_at, args.set)
+        fork.check_times(Simulation)
     if args.view:
         from astralis_des.sinks.viewer import require_display
 
@@ -35,7 +41,7 @@ def run_command(args: argparse.Namespace) -> int:
 
     def run(progress: Any) -> RunResult:
         made.append(Simulation(mission, out_dir=out, progress=progress, view=args.view))
-        return made[0].run()
+        return made[0].run() if fork is None else fork.run(made[0], Simulation)
 
     try:
         with holding(out):  # a second writer is refused before the world is built
@@ -79,6 +85,11 @@ def _print_summary(console: Any, result: RunResult, out: Path) -> None:
                   f"target in {result.target['room']}; {len(result.rounds)} assignment rounds, "
                   f"{len(result.rooms_searched)} rooms searched; "
                   f"{result.end_time:.1f} s simulated in {result.wall_time:.2f} s")
+    if result.fork is not None:
+        changed = [f"{k} = {v}" for k, v in result.fork["changes"].items()]
+        changed += [f"{e['event']} at {e['at']:.1f} s" for e in result.fork["timeline"]]
+        console.print(f"forked at {result.fork['point']} (t = {result.fork['t']:.1f} s, after "
+                      f"line {result.fork['lines']} of the event log): {'; '.join(changed)}")
     table = Table(title="team")
     table.add_column("robot", no_wrap=True)
     for header in ("kind", "dist m", "busy s", "idle s", "ok", "failed", "cancel", "preempt"):

@@ -119,6 +119,11 @@ for _kind in (
               ("room", "attempts"), ("reason",), level="WARN"),
     EventKind("team_lost", "no agent is left to search a segment: the mission ends",
               ("segment",), level="ERROR"),
+    EventKind("fork", "the run forks here (astralis run --fork-at): the mission's settings "
+              "changed from this point on, the events added to its timeline, and how many "
+              "rounds were decided and lines logged before it", ("point", "changes",
+                                                                 "timeline", "rounds", "lines"),
+              level="WARN"),
     EventKind("clutter_skipped", "an item of furniture found no free spot in its room",
               ("room", "item", "reason")),
     EventKind("make_way", "physics: a robot steps aside for another", ("for_robot", "to"),

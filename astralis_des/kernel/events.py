@@ -22,6 +22,7 @@ class EventLog:
         self.env = env
         self.records: list[Record] = []
         self.sinks: list[Sink] = []
+        self.watchers: list[Sink] = []  # called once every sink has a record (a fork)
         self.in_order = True  # every record's time at or after the one before
 
     def emit(self, kind: str, robot: str | None = None, *, at: float | None = None,
@@ -40,6 +41,8 @@ class EventLog:
         self.records.append(record)
         for sink in self.sinks:
             sink(record)
+        for watcher in self.watchers:
+            watcher(record)
         return record
 
     def of_kind(self, kind: str) -> list[Record]:

@@ -1,12 +1,13 @@
 """A mission as the command line and its front ends (``serve``, ``chat``) ask for it: the file
-with ``--seed``, ``--fidelity``, ``--no-recording`` and ``--manual`` applied, and its output
-folder."""
+with ``--seed``, ``--fidelity``, ``--no-recording``, ``--manual`` and ``run``'s ``--set``
+(unless it forks: the fork makes them) applied, and its output folder."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
+from astralis_des.mission.changes import changed_mission, parse_changes
 from astralis_des.mission.loader import Mission, load_mission
 from astralis_des.outdir import usable
 
@@ -27,6 +28,11 @@ def mission_from_args(args: argparse.Namespace) -> tuple[Mission, Path]:
     if getattr(args, "manual", False):  # serve and chat
         assignment = mission.spec.assignment.model_copy(update={"auto": False})
         mission = mission.with_changes(assignment=assignment.model_dump())
+    forks = getattr(args, "fork_at", None) is not None
+    if not forks:
+        mission = changed_mission(mission, parse_changes(getattr(args, "set", None) or []))
     out = Path(args.out or mission.spec.outputs.dir or Path("out") / mission.name)
+    if forks and not args.out:  # beside the run it forks, not over it
+        out = out.with_name(out.name + "-fork")
     usable(out)
     return mission, out

@@ -25,6 +25,7 @@ from astralis_des.kernel.handler import TaskHandler
 from astralis_des.kernel.robot import Robot
 from astralis_des.kernel.tasks import ActionResult, Stop, Task, TaskStatus
 from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.mission.changes import Changes
 from astralis_des.mission.draws import draw_rooms, draw_target
 from astralis_des.mission.loader import Mission
 from astralis_des.mission.spec import MemberSpec
@@ -32,6 +33,7 @@ from astralis_des.navsensors import BodySamples, PoseSensors, motion_poses
 from astralis_des.planning.navigator import Navigator
 from astralis_des.plugins import SENSORS, check_params
 from astralis_des.sensing import GeometricSensor, Sighting
+from astralis_des.simulation.fork import ForkPoint, prepare
 from astralis_des.simulation.outputs import OUTPUTS
 from astralis_des.simulation.result import RunResult, build_result
 from astralis_des.simulation.timeline import scheduled, search
@@ -58,7 +60,7 @@ class Simulation:
                  searcher: Searcher | None = None) -> None:
         spec = mission.spec
         self.view = view  # also stream the recording to a spawned Rerun viewer
-        self._searcher = searcher or search  # the process that decides the rounds
+        self.searcher = searcher or search  # the process that decides the rounds
         self._held: list[tuple[str, str, str]] = []
         self._end: simpy.Event | None = None
         self.mission = mission
@@ -292,6 +294,13 @@ class Simulation:
             result = self.finish()
         return result
 
+    def fork(self, at: str | ForkPoint, changes: Changes) -> RunResult:
+        """Run as ``run()`` does up to the fork point ``at`` (``round:N``, ``event:N`` or
+        ``time:T``), then make ``changes`` (``{KEY: value}`` or ``"KEY=VALUE"`` strings, as
+        ``astralis run --set``) and run on (docs/howto/fork.md). A point the run never
+        reaches raises :class:`~astralis_des.simulation.fork.ForkNotReached`, the run in it."""
+        return prepare(self.mission, at, changes).run(self, Simulation)
+
     def start(self) -> None:
         """Open the outputs and start the timeline; ``advance`` then moves time on."""
         if self._end is not None:
@@ -311,7 +320,7 @@ class Simulation:
                       team=[m.id for m in spec.team])
         ends = [self.found]
         if spec.assignment.auto:  # else the rounds come from commands (the API's assign)
-            self._timeline = self.env.process(self._searcher(self))
+            self._timeline = self.env.process(self.searcher(self))
             ends.append(self._timeline)
         for event in spec.timeline:
             self.env.process(scheduled(self, event))

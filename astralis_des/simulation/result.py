@@ -51,6 +51,8 @@ class RunResult:
     # the run's metrics (astralis_des.simulation.metrics): summary.json's last entry, where
     # floats are rounded to 1e-6 as everywhere in it (``plain(metrics)`` is what it holds)
     metrics: dict[str, Any] = field(default_factory=dict)
+    # a forked run's ``fork`` event (astralis_des.simulation.fork); summary.json has it then
+    fork: Record | None = None
 
     @property
     def found(self) -> bool:
@@ -67,6 +69,8 @@ class RunResult:
         data.pop("wall_time")
         data.pop("sensor_time")
         data.pop("allocation_time")
+        if data["fork"] is None:  # a run that did not fork: its summary as before forks
+            data.pop("fork")
         summary: dict[str, Any] = plain(data)
         return summary
 
@@ -100,7 +104,8 @@ def build_result(sim: Run, outcome: str, wall_time: float) -> RunResult:
         sensor_calls=dict(sorted(clock.calls.items())) if clock is not None else {},
         sensor_time=dict(sorted(clock.seconds.items())) if clock is not None else {},
         allocation_time=list(sim.allocation_time),
-        metrics=run_metrics(sim, sim.rounds, now, failed, time_to_find))
+        metrics=run_metrics(sim, sim.rounds, now, failed, time_to_find),
+        fork=next((r for r in sim.log.records if r["kind"] == "fork"), None))
 
 
 def room_report(sim: Run) -> dict[str, dict[str, Any]]:

@@ -30,25 +30,35 @@ TIMELINE_EVENTS: Registry[str, Handler] = Registry("timeline event")
 ALL = "all"  # the segment of a round given every searched room
 
 
-def search(sim: Run) -> Generator[simpy.Event, Any, str]:
+def search(sim: Run, before_round: Callable[[], None] | None = None
+           ) -> Generator[simpy.Event, Any, str]:
     """Search each segment in turn; a round matches the free agents to its pending rooms.
 
     A room whose search failed (no route, stuck) stays pending for the next round, up to
     ``max_attempts`` rounds; one whose searcher broke down (a fault, a crash) stays pending
     without using an attempt. A search that saw less of the room than ``min_coverage`` leaves
     it pending for an agent of a kind that has not searched it yet; when no such agent is
-    left, the room counts as searched as far as the team could see it. Returns why the search
+    left, the room counts as searched as far as the team could see it. ``before_round`` is
+    called as each round is about to be decided (a fork at a round). A strategy changed
+    mid-run (a fork) from one that plans a segment at a time to one that plans the whole
+    mission, or back, regroups the rooms left (:func:`regroup`). Returns why the search
     stopped.
     """
     attempts: Counter[str] = Counter()
     spec = sim.mission.spec.assignment
     if spec.start_at > 0:
         yield sim.env.timeout(spec.start_at)
-    for segment, rooms in groups(sim.mission):
-        pending = list(rooms)
+    left = groups(sim.mission)
+    while left:
+        segment, pending = left.pop(0)
         while pending:
             if sim.ended:  # the UAVs are landing: no more rounds
                 return "ended"
+            if before_round is not None:
+                before_round()
+            if _whole(sim.mission) != (segment == ALL):
+                left = regroup(sim.mission, [(segment, pending), *left])
+                break
             agents = [r for r in sim.robots.values() if not r.faulted]
             if not agents:
                 sim.log.emit("team_lost", segment=segment)
@@ -108,9 +118,27 @@ def groups(mission: Mission) -> list[tuple[str, list[str]]]:
     searched room at once (``all``) for a strategy that plans whole queues."""
     segments = mission.searched_segments()
     world = mission.world
-    if STRATEGIES.get(mission.spec.assignment.strategy).whole_mission:
+    if _whole(mission):
         return [(ALL, [r for seg in segments for r in world.segments[seg].rooms])]
     return [(seg, list(world.segments[seg].rooms)) for seg in segments]
+
+
+def regroup(mission: Mission, left: list[tuple[str, list[str]]]
+            ) -> list[tuple[str, list[str]]]:
+    """The rooms ``left`` (the current group's pending ones, then the later groups') as the
+    mission's strategy takes them now: all in one group (``all``), or by segment in the
+    search order; empty groups are dropped."""
+    rooms = [r for _, group in left for r in group]
+    if _whole(mission):
+        return [(ALL, rooms)] if rooms else []
+    regrouped = [(seg, [r for r in mission.world.segments[seg].rooms if r in rooms])
+                 for seg in mission.searched_segments()]
+    return [(seg, group) for seg, group in regrouped if group]
+
+
+def _whole(mission: Mission) -> bool:
+    """Does the mission's strategy plan the whole mission at once?"""
+    return STRATEGIES.get(mission.spec.assignment.strategy).whole_mission
 
 
 def _undercovered(sim: Run, room: str, robot: Any, outcome: ActionResult) -> bool:
