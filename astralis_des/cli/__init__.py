@@ -21,6 +21,7 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+from astralis_des.cli.diff import add_diff_parser, diff_command
 from astralis_des.cli.options import (
     Command,
     add_mission_options,
@@ -39,7 +40,7 @@ from astralis_des.exits import (
     interrupts_never_lost,
 )
 
-COMMANDS: dict[str, Command] = {"run": run_command, "world": world}
+COMMANDS: dict[str, Command] = {"run": run_command, "world": world, "diff": diff_command}
 
 
 def command(name: str) -> Callable[[Command], Command]:
@@ -78,6 +79,7 @@ def _parser() -> argparse.ArgumentParser:
                             "a browser instead.")
     replay.add_argument("recording", help="a recording.rrd")
     replay.add_argument("--web", action="store_true", help="serve the web viewer instead")
+    add_diff_parser(sub)
     export = sub.add_parser("export", help="write run.mcap for a run already made")
     export.add_argument("run_dir", help="a run's output folder (with its events.jsonl)")
     export.add_argument("--mcap", action="store_true", required=True,
