@@ -275,11 +275,11 @@ def test_world_rooms_lists_what_a_mission_can_name() -> None:
 
 
 # -- the same options everywhere ---------------------------------------------------------------
-COMMANDS = ["run", "replay", "export", "validate", "world", "study", "tune", "serve", "keys",
-            "chat", "teleop", "schema"]
+COMMANDS = ["run", "replay", "diff", "export", "validate", "world", "study", "tune", "serve",
+            "keys", "chat", "teleop", "schema"]
 WORLD_COMMANDS = ["rooms", "spots", "show", "import"]
-WRITERS = [["run"], ["study"], ["tune"], ["serve"], ["chat"], ["schema"], ["world", "show"],
-           ["world", "import"]]
+WRITERS = [["run"], ["diff"], ["study"], ["tune"], ["serve"], ["chat"], ["schema"],
+           ["world", "show"], ["world", "import"]]
 
 
 def help_text(capsys: pytest.CaptureFixture[str], *command: str) -> str:

@@ -173,7 +173,7 @@ def test_an_io_error_mid_run_is_one_line_and_leaves_nothing(
         tmp_path: Path, capsys: pytest.CaptureFixture[str],
         monkeypatch: pytest.MonkeyPatch) -> None:
     """EIO (a failing disk) while the event log is written: exit 74, one line."""
-    from astralis_des import sinks
+    from astralis_des.sinks import files as sinks
 
     written = [0]
     on_event = sinks.JsonlWriter.on_event

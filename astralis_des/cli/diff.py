@@ -70,7 +70,10 @@ def print_comparison(console: Any, comparison: Any) -> None:
 
     from astralis_des.compare.report import sections
 
-    console.print(headline(comparison))
+    for side, run in (("A", comparison.a), ("B", comparison.b)):
+        console.print(f"[bold]{side}[/]: {run.folder} ({run.summary.mission}: {run.label})",
+                      soft_wrap=True)
+    console.print(headline(comparison), soft_wrap=True)
     for section in sections(comparison):
         if not section.rows:
             console.print(f"{section.title}: none")

@@ -59,9 +59,7 @@ def found(run: Run) -> str:
 
 def _runs(c: Comparison) -> list[Row]:
     a, b = c.a.summary, c.b.summary
-    return [("folder", str(c.a.folder), str(c.b.folder), ""),
-            ("mission", f"{a.mission}: {c.a.label}", f"{b.mission}: {c.b.label}", ""),
-            ("target", a.target.get("room", "-"), b.target.get("room", "-"), ""),
+    return [("target", a.target.get("room", "-"), b.target.get("room", "-"), ""),
             ("found by", found(c.a), found(c.b), delta(a.time_to_find, b.time_to_find)),
             ("ended", f"{a.end_time:.1f} s, {rounds(len(a.rounds))}",
              f"{b.end_time:.1f} s, {rounds(len(b.rounds))}", delta(a.end_time, b.end_time))]
@@ -126,7 +124,8 @@ def _rooms(a: Run, b: Run) -> list[Row]:
 
 def markdown(c: Comparison) -> str:
     """The comparison as Markdown tables (the diff recording's summary panel)."""
-    lines = [f"**A**: {c.a.label} · **B**: {c.b.label}", ""]
+    lines = [f"**A**: {c.a.folder} ({c.a.summary.mission}: {c.a.label})  ",
+             f"**B**: {c.b.folder} ({c.b.summary.mission}: {c.b.label})", ""]
     for section in sections(c):
         lines += [f"**{section.title}**", "", "| | A | B | B - A |", "|---|---|---|---|"]
         lines += ["| " + " | ".join(cell.replace("|", "/") for cell in row) + " |"
