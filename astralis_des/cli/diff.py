@@ -60,8 +60,10 @@ def headline(comparison: Any) -> str:
     else:
         parts.append("every round's matching is the same")
     if e is not None:
-        parts.append(f"the first event that differs is line {e.line} (t = {e.t:.1f} s, "
-                     f"{(e.a or e.b or {}).get('kind', '?')})")
+        sides = [(side, r["kind"]) for side, r in (("A", e.a), ("B", e.b)) if r is not None]
+        what = sides[0][1] if len(sides) == 2 and sides[0][1] == sides[1][1] else \
+            ", ".join(f"{side} {kind}" for side, kind in sides)
+        parts.append(f"the first event that differs is line {e.line} (t = {e.t:.1f} s, {what})")
     return "; ".join(parts)
 
 

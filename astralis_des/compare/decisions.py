@@ -70,11 +70,15 @@ class EventDiff:
 
 @dataclass(frozen=True)
 class Comparison:
+    """Two runs compared (:func:`compare`): where they part (``round``, ``event``; ``None``
+    where they do not), each metric of either run with A's and B's value, each run's failed
+    tasks as text."""
+
     a: Run
     b: Run
     round: RoundDiff | None
     event: EventDiff | None
-    metrics: list[tuple[str, Value, Value]]  # name, A's, B's (None: the run has none)
+    metrics: list[tuple[str, Any, Any]]  # name, A's, B's (None: the run has none)
     failed_a: list[str]
     failed_b: list[str]
 
@@ -86,6 +90,7 @@ class Comparison:
 
 
 def compare(a: Run, b: Run) -> Comparison:
+    """Run ``b`` against run ``a`` (differences are B - A)."""
     return Comparison(a, b, first_round(a, b), first_event(a, b), metrics_of(a, b),
                       failed_tasks(a), failed_tasks(b))
 
@@ -131,7 +136,7 @@ def derived(run: Run) -> dict[str, Value]:
             "rounds": len(s.rounds), "end_time": s.end_time}
 
 
-def metrics_of(a: Run, b: Run) -> list[tuple[str, Value, Value]]:
+def metrics_of(a: Run, b: Run) -> list[tuple[str, Any, Any]]:
     """Each metric of either run, the summary's ``metrics`` first in their order, then those
     derived from the summary that they do not name."""
     ma, mb = a.summary.metrics or {}, b.summary.metrics or {}
@@ -140,7 +145,7 @@ def metrics_of(a: Run, b: Run) -> list[tuple[str, Value, Value]]:
     return [(n, ma.get(n, da.get(n)), mb.get(n, db.get(n))) for n in names]
 
 
-def difference(a: Value, b: Value) -> float | None:
+def difference(a: Any, b: Any) -> float | None:
     """B - A for two numbers (not for flags or text, nor where either has none)."""
     if isinstance(a, bool) or isinstance(b, bool):
         return None

@@ -67,8 +67,8 @@ def _scene(layout: DiffLayout) -> Any:
     cx, cy, span = (x0 + x1) / 2, (y0 + y1) / 2, max(x1 - x0, y1 - y0, 10.0)
     # steeper than a replay's, so that both runs' trails show; the rooms a little right of
     # and below the middle, toward where the team starts (south-east in the default world)
-    cx, cy = cx - 0.2 * span, cy + 0.15 * span
-    eye = rrb.EyeControls3D(position=(cx, cy - 0.9 * span, z1 + 2.2 * span),
+    cx, cy = cx - 0.3 * span, cy + 0.2 * span
+    eye = rrb.EyeControls3D(position=(cx, cy - 0.75 * span, z1 + 1.8 * span),
                             look_target=(cx, cy, 0.0))
     left_out = [f"- /{side}robots/*/{part}/**" for side in ("", "ghost/")
                 for part in HIDDEN_PARTS]

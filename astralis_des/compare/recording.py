@@ -80,7 +80,7 @@ def write_diff(c: Comparison, target: str | Path) -> Path:
         rec.log(DIFF_SUMMARY, rr.TextDocument(markdown(c), media_type=rr.MediaType.MARKDOWN),
                 static=True)
         rooms = _rooms(a)
-        _log_marker(rr, rec, c, rooms, _poses(a))
+        _log_marker(rr, rec, c, rooms, (_poses(a), _poses(b)))
         rec.send_blueprint(diff_blueprint(_layout(c, rooms, a)), make_active=True,
                            make_default=True)
         close_and_check(rec, path)
@@ -88,6 +88,7 @@ def write_diff(c: Comparison, target: str | Path) -> Path:
 
 
 Boxes = dict[str, tuple[np.ndarray, np.ndarray]]  # room -> centre, half sizes
+Track = tuple[np.ndarray, np.ndarray]  # a robot's times (s) and positions
 
 
 def _rooms(chunks: Sequence[Any]) -> Boxes:
@@ -101,8 +102,8 @@ def _rooms(chunks: Sequence[Any]) -> Boxes:
     return {}
 
 
-def _poses(chunks: Sequence[Any]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Each of A's robots' pose track: times (s) and positions."""
+def _poses(chunks: Sequence[Any]) -> dict[str, Track]:
+    """Each robot's pose track in a run's recording: times (s) and positions."""
     tracks: dict[str, list[tuple[float, list[float]]]] = {}
     for chunk in chunks:
         parts = chunk.entity_path.strip("/").split("/")
@@ -120,14 +121,16 @@ def _poses(chunks: Sequence[Any]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     return out
 
 
-def _at(track: tuple[np.ndarray, np.ndarray], t: float) -> np.ndarray:
+def _at(track: Track, t: float) -> np.ndarray:
     times, points = track
     return points[max(int(np.searchsorted(times, t, side="right")) - 1, 0)]
 
 
 def _log_marker(rr: Any, rec: Any, c: Comparison, rooms: Boxes,
-                poses: dict[str, tuple[np.ndarray, np.ndarray]]) -> None:
-    """The lane and the notes of the difference, and its flags in the 3-D view."""
+                poses: tuple[dict[str, Track], dict[str, Track]]) -> None:
+    """The lane and the notes of the difference, and its flags in the 3-D view: over the
+    rooms the first differing round assigned otherwise, over the robots of the first
+    differing event (A's and B's, where each was then)."""
     lane_t, lane_s = [0.0], ["same"]
     notes_t, notes, levels = [], [], []
     e, d = c.event, c.round
@@ -138,11 +141,11 @@ def _log_marker(rr: Any, rec: Any, c: Comparison, rooms: Boxes,
         notes.append(f"first event that differs, line {e.line}: A {brief(e.a)} | "
                      f"B {brief(e.b)}")
         levels.append("WARN")
-        robot = next((r.get("robot") for r in (e.a, e.b) if r and r.get("robot") in poses),
-                     None)
-        if robot is not None:
-            at = _at(poses[robot], e.t)
-            _flag(rr, rec, DIFF_EVENT, e.t, [at], [f"line {e.line}: {robot}"])
+        named = [(side, r) for side, r, mine in (("A", e.a, poses[0]), ("B", e.b, poses[1]))
+                 if r is not None and r.get("robot") in mine]
+        _flag(rr, rec, DIFF_EVENT, e.t,
+              [_at((poses[0] if side == "A" else poses[1])[r["robot"]], e.t) for side, r in named],
+              [f"line {e.line}: {side} {r['robot']} {r['kind']}" for side, r in named])
     if d is not None:
         lane_t.append(d.t)
         lane_s.append("decision differs")

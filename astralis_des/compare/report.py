@@ -8,7 +8,7 @@ from itertools import zip_longest
 from typing import Any
 
 from astralis_des.compare.decisions import Comparison, EventDiff, Pair, difference
-from astralis_des.compare.runs import Run, Value
+from astralis_des.compare.runs import Run
 
 Row = tuple[str, str, str, str]  # what, A, B, B - A (or a note)
 BRIEF_KEYS = ("round", "segment", "strategy", "op", "action", "room", "status", "message",
@@ -31,7 +31,7 @@ def sections(c: Comparison) -> list[Section]:
                                 for name, a, b in c.metrics])]
 
 
-def number(value: Value) -> str:
+def number(value: Any) -> str:
     if value is None:
         return "-"
     if isinstance(value, bool):
@@ -41,7 +41,7 @@ def number(value: Value) -> str:
     return str(value)
 
 
-def delta(a: Value, b: Value) -> str:
+def delta(a: Any, b: Any) -> str:
     d = difference(a, b)
     if d is None:
         return "" if a == b else "differs"
@@ -87,7 +87,7 @@ def _first(c: Comparison) -> list[Row]:
         rows.append(("round", "every round's matching is the same", "", ""))
     else:
         rows.append((f"round {d.number}", _round_side(d.number, d.a, d.only_a),
-                     _round_side(d.number, d.b, d.only_b), "the first matching that differs"))
+                     _round_side(d.number, d.b, d.only_b), ""))
     e = c.event
     if e is None:
         rows.append(("event", "the event logs are the same", "", ""))

@@ -58,7 +58,7 @@ class Summary(BaseModel):
     robots: dict[str, Robot]
     rounds: list[Round]
     rooms_searched: list[str]
-    metrics: dict[str, Value] | None = None  # the study metrics, in runs that write them
+    metrics: dict[str, Any] | None = None  # the study metrics, in runs that write them
 
 
 @dataclass(frozen=True)
