@@ -424,7 +424,9 @@ class Staging:
         _remove(trash)
         trash.mkdir()
         old = [self.last] if self.last is not None else []
-        result = any(os.path.lexists(place / key) for key in RESULT_KEYS)
+        # a folder that is an earlier result loses its other files; a file written into one
+        # (astralis diff -o RUN/diff.rrd) replaces itself and its sidecars, nothing more
+        result = not self.file and any(os.path.lexists(place / key) for key in RESULT_KEYS)
         old += sorted(self.owned | RESULT_FILES if result else self.owned) + names
         for name in dict.fromkeys(old):  # the old key file first
             if os.path.lexists(place / name):

@@ -173,6 +173,8 @@ def test_bad_input_is_one_line_and_exit_2(runs: dict[str, Path], tmp_path: Path)
         "cut": ((str(cut), "-o", str(out)), "cut/recording.rrd: not a whole Rerun recording"),
         "suffix": ((str(runs["fault"]), "-o", str(tmp_path / "d.txt")),
                    "d.txt: -o: give a file name ending in .rrd"),
+        "input": ((str(runs["fault"]), "-o", str(runs["fault"] / "recording.rrd")),
+                  "fault/recording.rrd: -o: is the recording of"),
     }
     for name, (args, message) in cases.items():
         code, stdout, err = run_cli("diff", str(runs["mixed"]), *args)
@@ -181,3 +183,16 @@ def test_bad_input_is_one_line_and_exit_2(runs: dict[str, Path], tmp_path: Path)
         assert not out.exists() and not list(tmp_path.glob(".d.rrd*")), name
         if name in ("unrecorded", "world"):  # the runs were read: their table is printed
             assert "found by" in stdout, name
+    assert broken(runs["fault"] / "recording.rrd") is None
+
+
+def test_a_diff_written_into_a_run_folder_leaves_the_run_as_it_is(
+        runs: dict[str, Path], tmp_path: Path) -> None:
+    """-o RUN/diff.rrd adds the file: the run's own files stay (a file target is not a
+    result folder to clear, even in a process that registered the run's files)."""
+    run = tmp_path / "run"
+    shutil.copytree(runs["fault"], run)
+    before = sorted(p.name for p in run.iterdir())
+    code, _, err = run_cli("diff", str(runs["mixed"]), str(run), "-o", str(run / "diff.rrd"))
+    assert (code, err) == (0, "")
+    assert sorted(p.name for p in run.iterdir()) == sorted([*before, "diff.rrd"])

@@ -68,6 +68,10 @@ def write_diff(c: Comparison, target: str | Path) -> Path:
 
     target = Path(target)
     check_target(target)
+    for run in (c.a, c.b):
+        if target.resolve() == (run.folder / RECORDING).resolve():
+            raise InputError(f"is the recording of {run.folder}: write the diff elsewhere",
+                             file=target, key="-o")
     a, b = recordings(c)
     with Staging(target, file=True) as folder:
         path = folder / target.name
