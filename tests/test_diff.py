@@ -88,10 +88,13 @@ def test_the_table_says_where_they_part_and_who_found_the_target(
     found = next(line for line in out.splitlines() if "found by" in line)
     assert f"{a['found_by']} at {a['time_to_find']:.1f} s" in found
     assert f"{b['found_by']} at {b['time_to_find']:.1f} s" in found
-    metric = next(line for line in out.splitlines() if "time_to_find" in line).split("│")
-    assert [c.strip() for c in metric[2:5]] == [
-        f"{a['time_to_find']:.1f}", f"{b['time_to_find']:.1f}",
-        f"{b['time_to_find'] - a['time_to_find']:+.1f}"]
+    rows = {cells[1].strip(): [c.strip() for c in cells[2:5]]
+            for cells in (line.split("│") for line in lines) if len(cells) == 6}
+    assert rows["time_to_find"] == [f"{a['time_to_find']:.1f}", f"{b['time_to_find']:.1f}",
+                                    f"{b['time_to_find'] - a['time_to_find']:+.1f}"]
+    assert set(a["metrics"]) <= set(rows)  # every metric of the summaries has its row
+    assert rows["human_close_s"][:2] == [f"{a['metrics']['human_close_s']:.3g}",
+                                         f"{b['metrics']['human_close_s']:.3g}"]
 
 
 def test_the_recording_holds_both_runs_and_where_they_part(fault: Comparison,

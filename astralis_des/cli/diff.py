@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from astralis_des.cli.options import add_out
+from astralis_des.errors import InputError
 
 RUN_HELP = ("a run's folder: what `astralis run -o DIR` wrote, or a study's "
             "DIR/scenarios/NNNNNN/VV_name (--recordings)")
@@ -39,12 +40,19 @@ def diff_command(args: argparse.Namespace) -> int:
 
         check_target(out)
     comparison = compare(load_run(args.run_a), load_run(args.run_b))
-    console = Console(soft_wrap=False)
-    print_comparison(console, comparison)
-    if out is not None:
+    failed: InputError | None = None
+    if out is not None:  # before the tables: a reader that goes away (| head) stops no write
         from astralis_des.compare.recording import write_diff
 
-        write_diff(comparison, out)
+        try:
+            write_diff(comparison, out)
+        except InputError as exc:  # said after the tables, which still print
+            failed = exc
+    console = Console(soft_wrap=False)
+    print_comparison(console, comparison)
+    if failed is not None:
+        raise failed
+    if out is not None:
         console.print(f"wrote {out} (astralis replay {out})")
     return 0
 

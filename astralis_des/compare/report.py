@@ -110,7 +110,8 @@ def brief(record: dict[str, Any] | None) -> str:
     """``t = 84.0 s uav1 task_started move A.1.2.1``, short (``-`` for none)."""
     if record is None:
         return "- (the log had ended)"
-    parts = [f"t = {float(record['t']):.1f} s", str(record.get("robot") or ""), record["kind"]]
+    parts = [f"t = {round(float(record['t']), 3):g} s", str(record.get("robot") or ""),
+             record["kind"]]
     parts += [str(record[k]) for k in BRIEF_KEYS if record.get(k) not in (None, "")]
     text = " ".join(p for p in parts if p)
     return text if len(text) <= BRIEF else text[:BRIEF - 3] + "..."
