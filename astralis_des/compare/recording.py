@@ -100,9 +100,12 @@ def _rooms(chunks: Sequence[Any]) -> Boxes:
     for chunk in chunks:
         if chunk.entity_path == f"/{paths.WORLD_ROOMS}":
             row = chunk.to_record_batch().slice(0, 1).to_pylist()[0]
-            return {str(label).split()[0]: (np.array(c), np.array(h)) for label, c, h in zip(
-                row["Boxes3D:labels"], row["Boxes3D:centers"], row["Boxes3D:half_sizes"],
-                strict=True)}
+            labels, centres, halves = (row.get(f"Boxes3D:{k}") or []
+                                       for k in ("labels", "centers", "half_sizes"))
+            if not len(labels) == len(centres) == len(halves):
+                return {}
+            return {str(label).split()[0]: (np.array(c), np.array(h))
+                    for label, c, h in zip(labels, centres, halves, strict=True) if label}
     return {}
 
 
@@ -114,6 +117,8 @@ def _poses(chunks: Sequence[Any]) -> dict[str, Track]:
         if chunk.is_static or parts[0] != "robots" or parts[-1] != "pose":
             continue
         batch = chunk.to_record_batch()
+        if not {paths.TIMELINE, "Points3D:positions"} <= set(batch.schema.names):
+            continue
         times = batch.column(paths.TIMELINE).cast("int64").to_numpy() / 1e9
         for t, points in zip(times, batch.column("Points3D:positions").to_pylist(), strict=True):
             if points:
@@ -189,8 +194,8 @@ def _flag(rr: Any, rec: Any, entity: str, t: float, feet: Sequence[np.ndarray],
 
 
 def _layout(c: Comparison, rooms: Boxes, a: Sequence[Any]) -> DiffLayout:
-    """Looking at the rooms either run assigned, without what is above the room where the
-    target was found (or, else, the rooms where the runs part, or the first searched)."""
+    """Looking at the rooms either run assigned, without the storeys above the target's room
+    (if either run found it) and the rooms where the runs part (else the first assigned)."""
     assigned = [m.room for run in (c.a, c.b) for r in run.summary.rounds for m in r.matching
                 if m.room in rooms] or list(rooms)
     shown = [r for r in ([c.a.summary.target.get("room")] if _found(c.a) or _found(c.b)
