@@ -22,8 +22,9 @@ FAULT_AT = 60.0  # uav2 fails between round 2 (54.1 s) and round 3 (84.0 s) of t
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    """The default mission as it is, with uav2 failing at 60 s, under greedy, and a mission of
-    another world: each run's folder, as ``astralis run -o`` writes it."""
+    """The default mission as it is, with uav2 failing at 60 s, under greedy, forked at round 3
+    to greedy, and a mission of another world: each run's folder, as ``astralis run -o``
+    writes it."""
     base = tmp_path_factory.mktemp("diff")
     mission = load_mission(MISSIONS / "urban_search.yaml")
     greedy = mission.spec.assignment.model_dump(mode="json") | {"strategy": "greedy"}
@@ -40,9 +41,11 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         "offices": load_mission(offices)}
     for name, m in missions.items():
         Simulation(m, out_dir=base / name).run()
+    Simulation(mission, out_dir=base / "fork").fork(at="round:3", changes={
+        "assignment.strategy": "greedy"})
     shutil.copytree(base / "mixed", base / "unrecorded")
     (base / "unrecorded" / "recording.rrd").unlink()
-    return {name: base / name for name in [*missions, "unrecorded"]}
+    return {name: base / name for name in [*missions, "unrecorded", "fork"]}
 
 
 @pytest.fixture(scope="module")
@@ -64,6 +67,22 @@ def test_a_fault_between_rounds_parts_the_runs_at_the_next_round(fault: Comparis
     assert fault.event is not None and fault.event.line == line
     assert fault.event.b is not None and fault.event.b["kind"] == "fault"
     assert fault.event.t == FAULT_AT and fault.first_time == FAULT_AT
+
+
+def test_a_fork_parts_from_its_original_at_its_fork_event(runs: dict[str, Path]) -> None:
+    """Forked at round 3: the logs are the same up to the fork event's line, which is the
+    first that differs; round 3, where greedy decides otherwise, is the first decision that
+    differs; the fork is named so."""
+    code, out, err = run_cli("diff", str(runs["mixed"]), str(runs["fork"]))
+    assert (code, err) == (0, "")
+    fork = load_run(runs["fork"])
+    line = next(n for n, e in enumerate(fork.events, start=1) if e["kind"] == "fork")
+    assert fork.summary.rounds[2].strategy == "greedy"
+    assert out.splitlines()[1] == (f"B: {runs['fork']} (urban_search: mixed->greedy, seed 42, "
+                                   "kinematic, forked at round:3)")
+    assert out.splitlines()[2] == (
+        "the first decision that differs is round 3 (t = 84.0 s); the first event that differs "
+        f"is line {line} (t = 84.0 s, A assignment, B fork)")
 
 
 def test_a_run_against_itself_does_not_part(runs: dict[str, Path]) -> None:

@@ -59,6 +59,7 @@ class Summary(BaseModel):
     rounds: list[Round]
     rooms_searched: list[str]
     metrics: dict[str, Any] | None = None  # the study metrics, in runs that write them
+    fork: dict[str, Any] | None = None  # a fork's point and changes (astralis run --fork-at)
 
 
 @dataclass(frozen=True)
@@ -70,14 +71,18 @@ class Run:
 
     @property
     def strategy(self) -> str:
-        """The strategy of its first round (``-`` for a run without one)."""
-        return next((r.strategy for r in self.summary.rounds if r.strategy), "-")
+        """Its rounds' strategies in order, ``mixed`` or ``mixed->cbba`` (a fork's), ``-`` for a
+        run without rounds."""
+        return "->".join(dict.fromkeys(r.strategy for r in self.summary.rounds
+                                       if r.strategy)) or "-"
 
     @property
     def label(self) -> str:
-        """``mixed, seed 42, kinematic``: what tells two runs of one mission apart."""
+        """``mixed, seed 42, kinematic``: what tells two runs of one mission apart (a fork's
+        says where it forked: ``mixed->cbba, seed 42, kinematic, forked at round:3``)."""
         s = self.summary
-        return f"{self.strategy}, seed {s.seed}, {s.fidelity}"
+        forked = f", forked at {s.fork['point']}" if s.fork and "point" in s.fork else ""
+        return f"{self.strategy}, seed {s.seed}, {s.fidelity}{forked}"
 
 
 def load_run(folder: str | Path) -> Run:
