@@ -46,7 +46,7 @@ def diff_blueprint(layout: DiffLayout) -> Any:
         rrb.TextDocumentView(origin=DIFF_SUMMARY, name="A vs B"),
         rrb.Horizontal(_events(paths.MISSION_EVENTS, f"A events: {layout.name_a}"),
                        _events(f"ghost/{paths.MISSION_EVENTS}", f"B events: {layout.name_b}")),
-        rrb.TimeSeriesView(origin="/", name="progress: rooms searched",
+        rrb.TimeSeriesView(origin="/", name="progress: rooms searched", axis_x=_span(layout),
                            contents=[f"+ /{paths.mission_metric('rooms_searched')}",
                                      f"+ /ghost/{paths.mission_metric('rooms_searched')}"]),
         row_shares=[3, 3, 2])
@@ -83,12 +83,9 @@ def _scene(layout: DiffLayout) -> Any:
 
 def _lanes(layout: DiffLayout) -> Any:
     """A's lanes beside B's, both over the longer run, each with the difference's lane."""
-    import rerun as rr
     import rerun.blueprint as rrb
 
-    span = rrb.TimeAxis(view_range=rr.TimeRange(
-        start=rr.TimeRangeBoundary.absolute(seconds=0.0),
-        end=rr.TimeRangeBoundary.absolute(seconds=layout.end * 1.03 + 1.0)))
+    span = _span(layout)
     return rrb.Horizontal(
         rrb.StateTimelineView(origin="/", name=f"A lanes: {layout.name_a}", time_view=span,
                               contents=[f"+ /{DIFF_LANE}",
@@ -97,6 +94,16 @@ def _lanes(layout: DiffLayout) -> Any:
                               time_view=span, contents=[
                                   f"+ /{DIFF_LANE}",
                                   *[f"+ /ghost/{paths.robot_state(r)}" for r in layout.robots_b]]))
+
+
+def _span(layout: DiffLayout) -> Any:
+    """The time axis over both runs, whole."""
+    import rerun as rr
+    import rerun.blueprint as rrb
+
+    return rrb.TimeAxis(view_range=rr.TimeRange(
+        start=rr.TimeRangeBoundary.absolute(seconds=0.0),
+        end=rr.TimeRangeBoundary.absolute(seconds=layout.end * 1.03 + 1.0)))
 
 
 def _events(origin: str, name: str) -> Any:

@@ -195,17 +195,17 @@ def _flag(rr: Any, rec: Any, entity: str, t: float, feet: Sequence[np.ndarray],
 
 def _layout(c: Comparison, rooms: Boxes, a: Sequence[Any]) -> DiffLayout:
     """Looking at the rooms either run assigned, without the storeys above the target's room
-    (if either run found it) and the rooms where the runs part (else the first assigned)."""
+    if either run found it (else above the first room where they part, or the first
+    assigned), as a run's replay looks into the storey where the target was found."""
     assigned = [m.room for run in (c.a, c.b) for r in run.summary.rounds for m in r.matching
                 if m.room in rooms] or list(rooms)
     shown = [r for r in ([c.a.summary.target.get("room")] if _found(c.a) or _found(c.b)
-                         else []) + (c.round.rooms if c.round else []) if r in rooms] \
-        or assigned[:1]
+                         else c.round.rooms if c.round else []) if r in rooms] or assigned[:1]
     lo = np.min([rooms[r][0] - rooms[r][1] for r in assigned], axis=0) if assigned else \
         np.zeros(3)
     hi = np.max([rooms[r][0] + rooms[r][1] for r in assigned], axis=0) if assigned else \
         np.full(3, 10.0)
-    top = max((float(rooms[r][0][2] + rooms[r][1][2]) for r in shown), default=None)
+    top = float(rooms[shown[0]][0][2] + rooms[shown[0]][1][2]) if shown else None
     robots = [list(run.summary.robots) for run in (c.a, c.b)]
     return DiffLayout(robots[0], robots[1], c.a.label, c.b.label,
                       ((float(lo[0]), float(lo[1]), float(lo[2])),
