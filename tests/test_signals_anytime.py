@@ -106,7 +106,8 @@ def test_a_signal_while_the_outputs_are_written_keeps_them_whole(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """SIGINT as the summary is written, and again as the folder is put in place: both
     wait until the folder is in place, then exit 130."""
-    from astralis_des import outdir, sinks
+    from astralis_des import outdir
+    from astralis_des.sinks import files as sinks
 
     close, place = sinks.SummaryWriter.close, outdir.Staging._place
 
