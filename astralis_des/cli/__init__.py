@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from astralis_des.cli.diff import add_diff_parser, diff_command
+from astralis_des.cli.falsify import add_falsify_parser, falsify
 from astralis_des.cli.options import (
     Command,
     add_mission_options,
@@ -40,7 +41,8 @@ from astralis_des.exits import (
     interrupts_never_lost,
 )
 
-COMMANDS: dict[str, Command] = {"run": run_command, "world": world, "diff": diff_command}
+COMMANDS: dict[str, Command] = {"run": run_command, "world": world, "diff": diff_command,
+                                "falsify": falsify}
 
 
 def command(name: str) -> Callable[[Command], Command]:
@@ -135,6 +137,7 @@ def _add_study_parsers(sub: Any) -> None:
     tune.add_argument("--resume", action="store_true",
                       help="go on after the trials the output folder holds")
     add_quiet(tune, "no progress bar or report")
+    add_falsify_parser(sub)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -44,6 +44,8 @@ class Setting:
     high_messiness: float
     time_limit: float
     options: dict[str, Any] = field(default_factory=dict)  # the baselines' (assignment.options)
+    # each scenario's mission changes, given instead of drawn (astralis falsify's trials)
+    given: tuple[dict[str, Any], ...] = ()
 
 
 @dataclass(frozen=True)

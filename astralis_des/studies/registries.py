@@ -10,6 +10,7 @@ from astralis_des.registry import Registry
 
 EVALUATIONS: Registry[str, Any] = Registry(
     "study evaluation",
-    plugins=("astralis_des.studies.eval_assignment", "astralis_des.studies.eval_mission"))
+    plugins=("astralis_des.studies.eval_assignment", "astralis_des.studies.eval_mission",
+             "astralis_des.studies.falsify_eval"))
 REPORTS: Registry[str, Any] = Registry(
     "study report", plugins=("astralis_des.studies.reports", "astralis_des.studies.table5"))

@@ -1,0 +1,100 @@
+"""``evaluate: falsify``: each scenario of a study is given, not drawn (a falsify trial's
+mission changes), and run under each variant's strategy; its row holds the run's metrics.
+
+Which way is worse, by metric: larger, except for the few where a smaller value is the bad
+one (:data:`SMALLEST_IS_WORST`). A trial's *badness* is the metric oriented so that larger is
+worse; a metric with no value in a run counts as described in :func:`badness`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from astralis_des.studies.eval_metrics import allocation_metrics
+from astralis_des.studies.eval_mission import METRICS as MISSION_METRICS
+from astralis_des.studies.eval_mission import search_time
+from astralis_des.studies.evaluation import Metric, evaluation
+from astralis_des.studies.factors import Setting, factor
+
+if TYPE_CHECKING:
+    from astralis_des.mission.loader import Mission
+    from astralis_des.simulation import Simulation
+    from astralis_des.simulation.result import RunResult
+    from astralis_des.studies.draws import Scenario
+    from astralis_des.studies.spec import Study, Variant
+
+METRICS = (
+    *MISSION_METRICS,
+    Metric("not_found", "not found", "rate"),
+    Metric("tasks_failed", "failed tasks", "mean"),
+)
+SMALLEST_IS_WORST = frozenset({"found", "human_min_distance", "rooms_per_robot"})
+
+
+def metric_names() -> list[str]:
+    return [m.column for m in METRICS]
+
+
+def worst_is_largest(metric: str) -> bool:
+    return metric not in SMALLEST_IS_WORST
+
+
+def badness(metric: str, value: float | None, time_limit: float,
+            largest: bool | None = None) -> float | None:
+    """``value`` oriented so that larger is worse. Time to find of a target never found is
+    the time limit; any other metric with no value (no search ended, no robot ever moved near
+    the person) has none, and the trial counts as failed for the optimiser."""
+    if value is None and metric == "time_to_find":
+        value = time_limit
+    if value is None:
+        return None
+    worse_up = worst_is_largest(metric) if largest is None else largest
+    return float(value) if worse_up else -float(value)
+
+
+@factor("given", list[dict[str, Any]], only="falsify")
+def _given(s: Setting, value: list[dict[str, Any]]) -> Setting:
+    """each scenario's mission changes (astralis falsify sets it)"""
+    return Setting(**{**s.__dict__, "given": tuple(value)})
+
+
+def trial_mission(base: Mission, changes: dict[str, Any], strategy: str,
+                  outputs: bool) -> Mission:
+    """The base mission with a trial's changes, under ``strategy`` (checked like a file)."""
+    assignment = {**changes["assignment"], "strategy": strategy}
+    return base.with_changes(**{**changes, "assignment": assignment}, outputs={
+        "dir": None, "events": outputs, "summary": outputs, "recording": outputs})
+
+
+def run_metrics(sim: Simulation, result: RunResult) -> dict[str, Any]:
+    """The study metrics of a finished run (what a study's mission row holds)."""
+    cfg = sim.mission.spec.assignment
+    high_risk = {r for r, st in sim.rooms.items() if st.risk >= cfg.high_risk}
+    high_mess = {r for r, st in sim.rooms.items() if st.messiness >= cfg.high_messiness}
+    row: dict[str, Any] = {
+        "found": int(result.found), "not_found": int(not result.found),
+        "time_to_find": result.time_to_find,
+        "human_high_risk_s": search_time(sim, "human", high_risk),
+        "ugv_high_mess_s": search_time(sim, "ugv", high_mess),
+        "rooms_searched": len(result.rooms_searched),
+        "distance": sum(st.distance for st in result.robots.values()),
+        "tasks_failed": sum(st.tasks_failed for st in result.robots.values()),
+    }
+    row.update(allocation_metrics(sim, result, cfg.high_risk, cfg.high_messiness))
+    return row
+
+
+@evaluation("falsify", METRICS, tradeoff=("human_high_risk_s", "ugv_high_mess_s"),
+            headline=("found", "time_to_find"))
+def evaluate_given(study: Study, scenario: Scenario, variant: Variant,
+                   out_dir: Path | None) -> dict[str, Any]:
+    from astralis_des.simulation import Simulation
+
+    s = variant.setting
+    mission = trial_mission(study.mission, s.given[scenario.index], s.strategy,
+                            out_dir is not None)
+    sim = Simulation(mission, out_dir=out_dir)
+    result = sim.run()
+    return {"outcome": result.outcome, "end_time": result.end_time,
+            "target_room": result.target["room"], **run_metrics(sim, result)}
