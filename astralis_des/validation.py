@@ -84,15 +84,25 @@ def _drop_union_tags(model: type[BaseModel], path: KeyPath) -> KeyPath:
     current: Any = model
     for part in path:
         candidates = _models_in(current)
-        if isinstance(part, str) and len(candidates) > 1 and not any(
+        union = len(candidates) > 1 or (bool(candidates) and _is_union(current))
+        if isinstance(part, str) and union and not any(
                 part in c.model_fields for c in candidates):
-            chosen = next((c for c in candidates if _is_tag(c, part)), None)
+            # one model beside scalars (``Range | Literal[False]``): its class name alone
+            chosen = next((c for c in candidates if _is_tag(c, part) and (
+                len(candidates) > 1 or part == c.__name__)), None)
             if chosen is not None:
                 current = chosen
                 continue
         kept.append(part)
         current = _step(current, part)
     return tuple(kept)
+
+
+def _is_union(annotation: Any) -> bool:
+    origin = typing.get_origin(annotation)
+    if origin is typing.Annotated:
+        return _is_union(typing.get_args(annotation)[0])
+    return origin in (typing.Union, types.UnionType)
 
 
 def _is_tag(model: type[BaseModel], part: str) -> bool:

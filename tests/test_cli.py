@@ -275,10 +275,10 @@ def test_world_rooms_lists_what_a_mission_can_name() -> None:
 
 
 # -- the same options everywhere ---------------------------------------------------------------
-COMMANDS = ["run", "replay", "diff", "export", "validate", "world", "study", "tune", "serve",
-            "keys", "chat", "teleop", "schema"]
+COMMANDS = ["run", "replay", "diff", "export", "validate", "world", "study", "tune", "falsify",
+            "serve", "keys", "chat", "teleop", "schema"]
 WORLD_COMMANDS = ["rooms", "spots", "show", "import"]
-WRITERS = [["run"], ["diff"], ["study"], ["tune"], ["serve"], ["chat"], ["schema"],
+WRITERS = [["run"], ["diff"], ["study"], ["tune"], ["falsify"], ["serve"], ["chat"], ["schema"],
            ["world", "show"], ["world", "import"]]
 
 

@@ -39,21 +39,21 @@ SAMPLERS: Registry[str, Callable[[int], Any]] = Registry("sampler")
 
 @SAMPLERS.register("tpe")
 def _tpe(seed: int) -> Any:
-    """TPE, one parameter at a time (Optuna's default), constant liar across a batch."""
+    """TPE over the joint space (multivariate, Optuna's default for one objective since 5.0),
+    constant liar across a batch."""
     import optuna
 
-    return optuna.samplers.TPESampler(seed=seed, constant_liar=True)
-
-
-@SAMPLERS.register("tpe-multivariate")
-def _tpe_multi(seed: int) -> Any:
-    """TPE over the joint space (multivariate, grouped), constant liar across a batch."""
-    import optuna
-
-    with warnings.catch_warnings():  # "experimental" features of long standing
+    with warnings.catch_warnings():  # "experimental" in Optuna 4
         warnings.simplefilter("ignore")
-        return optuna.samplers.TPESampler(seed=seed, constant_liar=True, multivariate=True,
-                                          group=True)
+        return optuna.samplers.TPESampler(seed=seed, constant_liar=True, multivariate=True)
+
+
+@SAMPLERS.register("tpe-independent")
+def _tpe_independent(seed: int) -> Any:
+    """TPE one parameter at a time, constant liar across a batch."""
+    import optuna
+
+    return optuna.samplers.TPESampler(seed=seed, constant_liar=True, multivariate=False)
 
 
 @SAMPLERS.register("random")

@@ -1,8 +1,8 @@
 """What ``astralis falsify`` searches: what a mission's seed would draw, as parameters.
 
-    target:   {rooms: [A.1.1.1, ...], place: true, avatar: true}  # where, and its posture
+    target:   {rooms: [A.1.1.1, ...], place: true, avatar: [activity, height]}
     rooms:    {rooms: [...], risk: {low: 0, high: 1}, messiness: {low: 0, high: 1},
-               sound: [minimal, moderate, loud]}                  # each room's properties
+               sound: false}                                      # each room's properties
     faults:   {robots: [uav1, ugv1], at: {low: 0, high: 400}, none: true}
     movers:   {low: 0, high: 4}                                   # moving obstacles
     starts:   {choices: 8, spacing: 4}                            # free spots near each start
@@ -11,9 +11,14 @@
 
 Every section may be ``false`` (the mission's own value is kept) and every key left out
 (the mission's own range: the searched rooms, Table II's attributes, risk and messiness on
-[0, 1], a fault of any member before the base mission ends, ...). A trial's parameters become
+[0, 1], a fault of any member before the base mission ends, ...). Sounds and the target's
+colour, gender and tie to a chair change nothing a run does (the replay shows them): they are
+left to the seed unless named (``sound: [minimal, moderate, loud]``, ``avatar: true``).
+A trial's parameters become
 mission changes (:meth:`Space.changes`): every drawn value set explicitly, so the trial is a
-complete mission file.
+complete mission file. The target's room takes its risk, messiness and sound from parameters
+of its own (``target.risk``, ...), not from its ``room.ID.*`` ones: what hides a target in
+clutter is then one thing to learn, whichever room it is in.
 """
 
 from __future__ import annotations
@@ -39,6 +44,11 @@ NO_FAULT = "none"
 PLACE_GRID = 0.1  # m: the free floor's cells the target's place snaps to
 LAYING = (1.8, 0.6)  # m: the footprint of a laying target (Scene's), else a standing one
 STANDING = (0.5, 0.5)
+ROOM_PROPS = ("risk", "messiness", "sound")
+# Table II's attributes that change what a run does (a laying target's footprint, a patrolling
+# one's walk and its height); colour, gender and the tie to a chair are only shown
+AvatarKey = Literal["activity", "color", "gender", "height", "tied_to_chair"]
+SHAPING: tuple[AvatarKey, ...] = ("activity", "height")
 COMM_RANGE = (5.0, 100.0)  # m: CBBA's range searched when the space file says nothing
 
 
@@ -73,7 +83,9 @@ class TargetSpace(Strict):
     rooms: list[str] | None = Field(None, min_length=1,
                                     description="default: the mission's searched rooms")
     place: bool = Field(True, description="where in its room (a free spot)")
-    avatar: bool = Field(True, description="its posture and Table II's other attributes")
+    avatar: tuple[AvatarKey, ...] | bool = Field(
+        SHAPING, description="Table II's attributes searched (true: all of them); by "
+        "default those that change a run: the posture and, for a patrolling target, height")
 
 
 class RoomsSpace(Strict):
@@ -81,7 +93,7 @@ class RoomsSpace(Strict):
                                     description="default: the mission's searched rooms")
     risk: Range | Literal[False] = Range(low=0.0, high=1.0)
     messiness: Range | Literal[False] = Range(low=0.0, high=1.0)
-    sound: tuple[Sound, ...] | Literal[False] = ("minimal", "moderate", "loud")  # SOUNDS
+    sound: tuple[Sound, ...] | Literal[False] = False  # changes nothing a run does (shown)
 
 
 class FaultSpace(Strict):
@@ -148,13 +160,17 @@ class Space:
         out: dict[str, Any] = {}
         if "seed" in params:
             out["seed"] = int(params["seed"])
+        out["target"] = self._target(params)
         rooms = spec.rooms.model_dump(mode="json", exclude_none=True)
         for name, value in params.items():
             if name.startswith("room."):
                 room, _, prop = name[len("room."):].rpartition(".")
                 rooms["set"].setdefault(room, {})[prop] = _rounded(value)
+        where = out["target"].get("room")
+        for prop in ROOM_PROPS:  # the target's room's own: one parameter whatever the room
+            if f"target.{prop}" in params and where is not None:
+                rooms["set"].setdefault(where, {})[prop] = _rounded(params[f"target.{prop}"])
         out["rooms"] = rooms
-        out["target"] = self._target(params)
         timeline = [e.model_dump(mode="json") for e in spec.timeline]
         robot = params.get("fault.robot", NO_FAULT)
         if robot != NO_FAULT:
@@ -273,24 +289,30 @@ def build_space(spec: SpaceSpec, doc: LocatedYaml, mission: Mission, strategies:
         if target.place and given.target.position is None:
             dims["target.x"] = Dim()
             dims["target.y"] = Dim()
-        if target.avatar:
-            fixed = given.target.avatar.model_dump(exclude_none=True)
-            for key, values in AVATAR_VALUES.items():
-                if key not in fixed:
-                    dims[f"target.{key}"] = Dim(tuple(values))
+        searched = (list(AVATAR_VALUES) if target.avatar is True else
+                    [] if target.avatar is False else target.avatar)
+        fixed = given.target.avatar.model_dump(exclude_none=True)
+        for key, values in AVATAR_VALUES.items():
+            if key in searched and key not in fixed:
+                dims[f"target.{key}"] = Dim(tuple(values))
     if spec.rooms is not False:
         props = spec.rooms
+        if props.sound == ():
+            raise doc.error(("rooms", "sound"), "no sounds: give at least one, or false to "
+                            "keep the mission's")
+        ranges = {}
+        for prop in ROOM_PROPS:
+            bound = getattr(props, prop)
+            if isinstance(bound, Range):
+                _within(doc, ("rooms", prop), bound, 0.0, 1.0)
+                ranges[prop] = Dim(low=bound.low, high=bound.high)
+            elif bound is not False:
+                ranges[prop] = Dim(tuple(dict.fromkeys(bound)))
+        if spec.target is not False:  # the target's room: its own parameters, so that what
+            # hides a target is learnt once, not once per room it may be in
+            dims.update({f"target.{prop}": dim for prop, dim in ranges.items()})
         for room in rooms_at(("rooms", "rooms"), props.rooms):
-            for prop in ("risk", "messiness"):
-                bound = getattr(props, prop)
-                if bound is not False:
-                    _within(doc, ("rooms", prop), bound, 0.0, 1.0)
-                    dims[f"room.{room}.{prop}"] = Dim(low=bound.low, high=bound.high)
-            if props.sound == ():
-                raise doc.error(("rooms", "sound"), "no sounds: give at least one, or false "
-                                "to keep the mission's")
-            if props.sound is not False:
-                dims[f"room.{room}.sound"] = Dim(tuple(dict.fromkeys(props.sound)))
+            dims.update({f"room.{room}.{prop}": dim for prop, dim in ranges.items()})
     if spec.faults is not False:
         robots = robots_at(("faults", "robots"), spec.faults.robots)
         choices = ([NO_FAULT] if spec.faults.none else []) + robots
