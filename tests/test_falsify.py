@@ -38,11 +38,6 @@ def against(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
-def summary_value(summary: dict[str, object], metric: str) -> object:
-    metrics = summary.get("metrics")
-    return (metrics if isinstance(metrics, dict) else summary)[metric]
-
-
 def test_the_worst_mission_reproduces_its_metric(searched: Path, tmp_path: Path) -> None:
     """``astralis run worst/01.yaml`` writes the trial's time to find, to the byte."""
     trials = pq.read_table(searched / "trials.parquet").to_pylist()
@@ -54,7 +49,7 @@ def test_the_worst_mission_reproduces_its_metric(searched: Path, tmp_path: Path)
     assert main(["run", str(searched / "worst" / "01.yaml"), "-o", str(tmp_path / "run"),
                  "--no-recording", "-q"]) == 0
     summary = json.loads((tmp_path / "run" / "summary.json").read_text(encoding="utf-8"))
-    assert json.dumps(summary_value(summary, "time_to_find")) == value
+    assert json.dumps(summary["metrics"]["time_to_find"]) == value
     assert summary["mission"] == "urban_search_worst01"
 
 
@@ -80,8 +75,9 @@ def test_the_folder_holds_every_trial_and_the_report(searched: Path) -> None:
     assert meta["trials"] == {"optimiser": 4, "random": 4} and meta["sampler"] == "tpe"
 
 
-def test_against_scores_the_gap_on_the_same_scenario(against: Path) -> None:
-    """With --against, each trial runs both strategies; its score is mixed's less greedy's."""
+def test_against_scores_the_gap_on_the_same_scenario(against: Path, tmp_path: Path) -> None:
+    """With --against, each trial runs both strategies; its score is mixed's less greedy's;
+    the worst file runs mixed, to the trial's value."""
     trials = pq.read_table(against / "trials.parquet").to_pylist()
     assert len(trials) == 4
     for t in trials:
@@ -92,6 +88,10 @@ def test_against_scores_the_gap_on_the_same_scenario(against: Path) -> None:
     best = max(trials, key=lambda t: t["score"])
     assert f"under greedy; the gap (worse for mixed) is {best['score']:.6g}" in text
     assert "strategy: mixed" in text
+    assert main(["run", str(against / "worst" / "01.yaml"), "-o", str(tmp_path / "run"),
+                 "--no-recording", "-q"]) == 0
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text(encoding="utf-8"))
+    assert json.dumps(summary["metrics"]["human_high_risk_s"]) == json.dumps(best["value"])
 
 
 def test_the_trials_depend_on_the_seed_not_the_workers() -> None:

@@ -182,9 +182,8 @@ def base_run(mission: Mission, strategy: str) -> dict[str, Any]:
                                              "strategy": strategy},
                                  outputs={"dir": None, "events": False, "summary": False,
                                           "recording": False})
-    sim = Simulation(plain)
-    result = sim.run()
-    return {"end_time": result.end_time, **run_metrics(sim, result)}
+    result = Simulation(plain).run()
+    return {"end_time": result.end_time, **run_metrics(result)}
 
 
 def run_falsify(f: Falsify, *, workers: int = 1, backend: str | Backend = "local",

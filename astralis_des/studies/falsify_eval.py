@@ -11,23 +11,24 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from astralis_des.studies.eval_metrics import allocation_metrics
+from astralis_des.kernel.events import plain
 from astralis_des.studies.eval_mission import METRICS as MISSION_METRICS
-from astralis_des.studies.eval_mission import search_time
 from astralis_des.studies.evaluation import Metric, evaluation
 from astralis_des.studies.factors import Setting, factor
 
 if TYPE_CHECKING:
     from astralis_des.mission.loader import Mission
-    from astralis_des.simulation import Simulation
     from astralis_des.simulation.result import RunResult
     from astralis_des.studies.draws import Scenario
     from astralis_des.studies.spec import Study, Variant
 
-METRICS = (
+METRICS = (  # RunResult.metrics (summary.json's), and not_found (summary.json: not found)
     *MISSION_METRICS,
     Metric("not_found", "not found", "rate"),
     Metric("tasks_failed", "failed tasks", "mean"),
+    Metric("rooms_per_robot", "rooms per robot", "mean"),
+    Metric("high_risk_rooms", "high-risk rooms", "mean"),
+    Metric("high_mess_rooms", "high-messiness rooms", "mean"),
 )
 SMALLEST_IS_WORST = frozenset({"found", "human_min_distance", "rooms_per_robot"})
 
@@ -67,22 +68,11 @@ def trial_mission(base: Mission, changes: dict[str, Any], strategy: str,
         "dir": None, "events": outputs, "summary": outputs, "recording": outputs})
 
 
-def run_metrics(sim: Simulation, result: RunResult) -> dict[str, Any]:
-    """The study metrics of a finished run (what a study's mission row holds)."""
-    cfg = sim.mission.spec.assignment
-    high_risk = {r for r, st in sim.rooms.items() if st.risk >= cfg.high_risk}
-    high_mess = {r for r, st in sim.rooms.items() if st.messiness >= cfg.high_messiness}
-    row: dict[str, Any] = {
-        "found": int(result.found), "not_found": int(not result.found),
-        "time_to_find": result.time_to_find,
-        "human_high_risk_s": search_time(sim, "human", high_risk),
-        "ugv_high_mess_s": search_time(sim, "ugv", high_mess),
-        "rooms_searched": len(result.rooms_searched),
-        "distance": sum(st.distance for st in result.robots.values()),
-        "tasks_failed": sum(st.tasks_failed for st in result.robots.values()),
-    }
-    row.update(allocation_metrics(sim, result, cfg.high_risk, cfg.high_messiness))
-    return row
+def run_metrics(result: RunResult) -> dict[str, Any]:
+    """A finished run's metrics as its ``summary.json`` holds them (rounded), and
+    ``not_found``: so a trial's value is the file's to the byte."""
+    metrics: dict[str, Any] = plain(result.metrics)
+    return {**metrics, "not_found": not metrics["found"]}
 
 
 @evaluation("falsify", METRICS, tradeoff=("human_high_risk_s", "ugv_high_mess_s"),
@@ -94,7 +84,6 @@ def evaluate_given(study: Study, scenario: Scenario, variant: Variant,
     s = variant.setting
     mission = trial_mission(study.mission, s.given[scenario.index], s.strategy,
                             out_dir is not None)
-    sim = Simulation(mission, out_dir=out_dir)
-    result = sim.run()
+    result = Simulation(mission, out_dir=out_dir).run()
     return {"outcome": result.outcome, "end_time": result.end_time,
-            "target_room": result.target["room"], **run_metrics(sim, result)}
+            "target_room": result.target["room"], **run_metrics(result)}

@@ -110,7 +110,7 @@ def header(result: FalsifyResult, row: dict[str, Any], rank: int, where: Path) -
                      f"the gap (worse for {f.strategy}) is {row['score']:.6g}")
     lines += [f"found by the {row['search']} search, trial {row['trial']}",
               f"reproduce: astralis run {_shown(where / f'{rank:02d}.yaml')} (summary.json: "
-              f"metrics.{f.metric})"]
+              + ("not metrics.found)" if f.metric == "not_found" else f"metrics.{f.metric})")]
     return "".join(f"# {line}\n" for line in lines)
 
 
