@@ -9,7 +9,8 @@ strategy's badness less the other's). An Optuna sampler, seeded, proposes trials
 apart). The same number of trials drawn at random is the baseline it must beat.
 
 Trials depend on the seed, the sampler and the batch, never on the workers or the backend: a
-command gives the same trials on any machine.
+command gives the same trials on any machine. A sampler blind to the results (random, QMC)
+gives the same trials in any batches, and runs in larger ones.
 """
 
 from __future__ import annotations
@@ -91,6 +92,8 @@ def _cmaes(seed: int) -> Any:
 
 
 DEFAULT_SAMPLER = "tpe"
+BLIND = frozenset({"random", "qmc"})  # samplers whose trials do not depend on the results
+BLIND_BATCH = 16  # ... so they run in larger batches: fewer waits for a batch's slowest run
 
 
 # -- the request and its result --------------------------------------------------------------
@@ -178,11 +181,11 @@ def base_run(mission: Mission, strategy: str) -> dict[str, Any]:
     window's by default)."""
     from astralis_des.simulation import Simulation
 
-    plain = mission.with_changes(assignment={**mission.spec.assignment.model_dump(mode="json"),
+    given = mission.with_changes(assignment={**mission.spec.assignment.model_dump(mode="json"),
                                              "strategy": strategy},
                                  outputs={"dir": None, "events": False, "summary": False,
                                           "recording": False})
-    result = Simulation(plain).run()
+    result = Simulation(given).run()
     return {"end_time": result.end_time, **run_metrics(result)}
 
 
@@ -236,9 +239,11 @@ def _search(f: Falsify, study: Study, runner: Backend, search: str, sampler: Any
 
     opt = optuna.create_study(direction="maximize", sampler=sampler)
     spaces = f.space.distributions()
+    blind = search == SEARCHES[1] or f.sampler in BLIND
+    size = max(f.batch, BLIND_BATCH) if blind else f.batch  # the same trials, told later
     number = 0
     while number < f.trials:
-        asked = [opt.ask(spaces) for _ in range(min(f.batch, f.trials - number))]
+        asked = [opt.ask(spaces) for _ in range(min(size, f.trials - number))]
         changes = [f.space.changes(t.params) for t in asked]
         batch = study.with_changes(scenarios=len(asked), set={"given": changes})
         ran = run_study(batch, backend=runner)
@@ -248,7 +253,7 @@ def _search(f: Falsify, study: Study, runner: Backend, search: str, sampler: Any
         for row in ran.rows:
             by_trial.setdefault(row["scenario"], {})[row["variant"]] = row
         for i, trial in enumerate(asked):
-            row = _row(f, search, number + i, number // f.batch, trial.params, changes[i],
+            row = _row(f, search, number + i, number // size, trial.params, changes[i],
                        by_trial.get(i, {}))
             result.rows.append(row)
             if row["score"] is None:

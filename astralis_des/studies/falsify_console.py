@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import shlex
-import sys
 from pathlib import Path
 
 from rich.console import Console
@@ -61,7 +60,7 @@ def falsify_command(args: argparse.Namespace) -> int:
             with Staging(out, owned=FALSIFY_FILES, last="meta.json") as folder:
                 chosen = write_falsify(result, folder, out, worst=args.worst,
                                        recordings=args.recordings,
-                                       command=shlex.join(["astralis", *sys.argv[1:]]))
+                                       command=command_line(args, strategy))
     except KeyboardInterrupt:
         console.print("[yellow]interrupted[/]; nothing written")
         return EXIT_INTERRUPTED
@@ -70,17 +69,30 @@ def falsify_command(args: argparse.Namespace) -> int:
                       f"{out}/")
         return EXIT_INTERRUPTED
     if not args.quiet:
-        stdout = Console()
+        stdout = Console(soft_wrap=True)
         for search in ("optimiser", "random"):
             curve = best_so_far(result, search)
             if curve:
+                worst = "none" if curve[-1] is None else f"{curve[-1]:.6g}"
                 stdout.print(f"{search}: {len(curve)} trials in "
-                             f"{result.wall_time.get(search, 0):.1f} s, worst score "
-                             f"{curve[-1] if curve[-1] is not None else 'none'}")
+                             f"{result.wall_time.get(search, 0):.1f} s, worst score {worst}")
         for rank, row in enumerate(chosen, 1):
-            extra = (f", {args.against} {row['value_against']}, gap {row['score']:.4g}"
+            extra = (f"; {args.against}: {row['value_against']}, gap {row['score']:.6g}"
                      if args.against else "")
-            stdout.print(f"{out}/worst/{rank:02d}.yaml: {args.metric} {row['value']} "
-                         f"({strategy}{extra})")
+            stdout.print(f"{out}/worst/{rank:02d}.yaml: {args.metric} {row['value']} under "
+                         f"{strategy}{extra}")
         stdout.print(f"outputs: {out}/ (report.md, trials.parquet, worst/)")
     return 0
+
+
+def command_line(args: argparse.Namespace, strategy: str) -> str:
+    """The command that asks for the same trials (what decides them, not where they run)."""
+    words = ["astralis", "falsify", args.mission, "--strategy", strategy, "--metric",
+             args.metric]
+    for option, value in (("--against", args.against), ("--worst-is", args.worst_is),
+                          ("--space", args.space)):
+        if value is not None:
+            words += [option, value]
+    words += ["--trials", str(args.trials), "--sampler", args.sampler, "--seed",
+              str(args.seed), "--batch", str(args.batch)]
+    return shlex.join(words + (["--no-baseline"] if args.no_baseline else []))

@@ -8,6 +8,7 @@ worse; a metric with no value in a run counts as described in :func:`badness`.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -57,7 +58,7 @@ def badness(metric: str, value: float | None, time_limit: float,
 @factor("given", list[dict[str, Any]], only="falsify")
 def _given(s: Setting, value: list[dict[str, Any]]) -> Setting:
     """each scenario's mission changes (astralis falsify sets it)"""
-    return Setting(**{**s.__dict__, "given": tuple(value)})
+    return replace(s, given=tuple(value))
 
 
 def trial_mission(base: Mission, changes: dict[str, Any], strategy: str,

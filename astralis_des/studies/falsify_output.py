@@ -51,7 +51,7 @@ def write_falsify(result: FalsifyResult, folder: Path, final: Path, *, worst: in
         write_table(pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in rows]),
                     folder, "trials")
         write_plots(result, folder / "plots", ranks)
-    write_file(folder / "report.md", report_markdown(result, chosen, ranks))
+    write_file(folder / "report.md", report_markdown(result, chosen, ranks, command))
     if recordings:
         record(result, chosen, folder / "recordings")
     f = result.falsify

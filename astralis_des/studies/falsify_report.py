@@ -15,6 +15,7 @@ from astralis_des.studies.reports import TextTable
 
 log = logging.getLogger(__name__)
 SHOWN_PARAMS = 12  # parameters the importance table and plot show
+IMPORTANCE_MIN = 20  # random trials that make a sample to rank the parameters on
 
 
 def _fmt(value: Any) -> str:
@@ -35,14 +36,18 @@ def best_so_far(result: FalsifyResult, search: str) -> list[float | None]:
 
 
 def importance(result: FalsifyResult) -> dict[str, float]:
-    """Each parameter's importance to landing in the worst tenth of the trials (PED-ANOVA
-    over every trial with a score, the optimiser's and random's); empty when too few."""
+    """Each parameter's importance to landing in the worst tenth of the trials (PED-ANOVA):
+    over the random search's trials, an even sample of the space (the optimiser's crowd
+    where it found the worst, which hides what took it there), else over the optimiser's;
+    empty when too few."""
     import optuna
     from optuna.importance import PedAnovaImportanceEvaluator, get_param_importances
 
     f = result.falsify
     spaces = f.space.distributions()
     scored = [r for r in result.rows if r["score"] is not None]
+    even = [r for r in scored if r["search"] == SEARCHES[1]]
+    scored = even if len(even) >= IMPORTANCE_MIN else scored
     if len({r["score"] for r in scored}) < 2:
         return {}
     study = optuna.create_study(direction="maximize")
@@ -66,7 +71,7 @@ def score_label(result: FalsifyResult) -> str:
 
 
 def report_markdown(result: FalsifyResult, chosen: list[dict[str, Any]],
-                    ranks: dict[str, float]) -> str:
+                    ranks: dict[str, float], command: str = "") -> str:
     f = result.falsify
     blocks: list[str | TextTable] = [
         f"# Falsify {f.mission.name}: {f.strategy} on {f.metric}"
@@ -75,6 +80,8 @@ def report_markdown(result: FalsifyResult, chosen: list[dict[str, Any]],
         f"{f.batch})" + (", and as many drawn at random" if f.baseline else "") + "; "
         f"the {'largest' if f.largest else 'smallest'} {f.metric} is the worst"
         + ("; interrupted" if result.interrupted else "") + "."]
+    if command:
+        blocks.append(f"The same trials again: `{command}`")
     if result.base:
         blocks.append(f"The mission as given: {f.metric} = {_fmt(result.base.get(f.metric))} "
                       f"under {f.strategy}.")
@@ -84,8 +91,9 @@ def report_markdown(result: FalsifyResult, chosen: list[dict[str, Any]],
     blocks += ["## What drives failure"]
     if ranks:
         blocks += ["PED-ANOVA importance of each parameter: how much its values in the worst "
-                   "tenth of the trials (optimiser's and random's) differ from its values in "
-                   "all of them; the first ones:", "![importance](plots/importance.png)",
+                   "tenth of the random search's trials (an even sample of the space; without "
+                   "it, the optimiser's) differ from its values in all of them; the first "
+                   "ones:", "![importance](plots/importance.png)",
                    TextTable("", ["parameter", "importance"],
                              [[k, f"{v:.3f}"] for k, v in list(ranks.items())[:SHOWN_PARAMS]])]
     else:
