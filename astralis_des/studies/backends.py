@@ -122,6 +122,7 @@ class RayBackend:
                              "pip install 'astralis-des[ray]'", key="backend") from None
         self.workers = max(1, workers)
         self.address = address
+        self._started = False  # an instance of ours kept by hold() until close()
 
     def run(self, study: Study, chunks: Sequence[list[int]],
             recordings: Path | None) -> Generator[ChunkResult, None, None]:
@@ -164,10 +165,21 @@ class RayBackend:
                 key="address") from None
 
     def hold(self, base: Study) -> None:
-        """Nothing kept: each run starts its actors (a cluster's are shared)."""
+        """One Ray instance (or connection) for the runs that follow, until :meth:`close`
+        (each run starts its actors): a tune's trials or a falsify's batches do not start
+        Ray each time."""
+        import ray
+
+        if not ray.is_initialized():
+            self._connect()
+            self._started = True
 
     def close(self) -> None:
-        pass
+        if self._started:
+            import ray
+
+            ray.shutdown()
+            self._started = False
 
 
 class _RayRun:
