@@ -126,6 +126,29 @@ def test_a_trial_is_a_complete_mission() -> None:
     mission.with_changes(**changes)  # checked as a file is
 
 
+def test_a_space_file_narrows_and_widens_the_space(tmp_path: Path) -> None:
+    """Sections set to false keep the mission's values; sounds, looks and the seed are
+    searched only when named."""
+    path = tmp_path / "space.yaml"
+    path.write_text("target: {rooms: [A.3.1.1, A.3.1.2], place: false, avatar: true}\n"
+                    "rooms: {rooms: [A.3.1.1], risk: false, sound: [loud, minimal]}\n"
+                    "faults: false\nmovers: false\nstarts: false\nseed: {low: 0, high: 9}\n",
+                    encoding="utf-8")
+    space = load_space(path, load_mission(MISSION), strategies=["mixed"], fault_until=1.0)
+    assert list(space.dims) == [
+        "seed", "target.room", "target.activity", "target.color", "target.gender",
+        "target.height", "target.tied_to_chair", "target.messiness", "target.sound",
+        "room.A.3.1.1.messiness", "room.A.3.1.1.sound"]
+    assert space.dims["room.A.3.1.1.sound"].choices == ("loud", "minimal")
+    changes = space.changes({"seed": 4, "target.room": "A.3.1.2", "target.messiness": 0.91234,
+                             "target.sound": "loud", "room.A.3.1.1.messiness": 0.2,
+                             "room.A.3.1.1.sound": "minimal"})
+    assert changes["seed"] == 4 and changes["timeline"] == [] and "position" not in \
+        changes["target"]
+    assert changes["rooms"]["set"] == {"A.3.1.1": {"messiness": 0.2, "sound": "minimal"},
+                                       "A.3.1.2": {"messiness": 0.912, "sound": "loud"}}
+
+
 def bad(tmp_path: Path, capsys: pytest.CaptureFixture[str], *args: str) -> str:
     out = tmp_path / "out"
     assert main(["falsify", str(MISSION), "--trials", "2", "-o", str(out), "-q",
@@ -144,6 +167,8 @@ def test_bad_input_is_one_line_and_nothing_written(tmp_path: Path,
         "error: --strategy: ")
     assert bad(tmp_path, capsys, "--against", "mixed") == (
         "error: --against: 'mixed' is the strategy itself: compare it with another\n")
+    assert bad(tmp_path, capsys, "--sampler", "tpee") == (
+        "error: --sampler: unknown sampler 'tpee'; did you mean 'tpe'?\n")
     space = tmp_path / "space.yaml"
     space.write_text("rooms:\n  risk: {low: 0.5, high: 1}\ntarget:\n  roomz: [A.1.1.1]\n",
                      encoding="utf-8")
