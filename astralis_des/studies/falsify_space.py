@@ -292,6 +292,8 @@ def build_space(spec: SpaceSpec, doc: LocatedYaml, mission: Mission, strategies:
         searched = (list(AVATAR_VALUES) if target.avatar is True else
                     [] if target.avatar is False else target.avatar)
         fixed = given.target.avatar.model_dump(exclude_none=True)
+        if fixed.get("tied_to_chair"):  # tied to a chair: sitting (the loader's rule)
+            fixed["activity"] = "sitting"
         for key, values in AVATAR_VALUES.items():
             if key in searched and key not in fixed:
                 dims[f"target.{key}"] = Dim(tuple(values))
