@@ -57,7 +57,10 @@ class OutputError(Exception):
 def write_failure(path: str | Path, exc: OSError) -> Exception:
     """An ``OSError`` from writing ``path`` as the error a person reads: a machine error
     (:class:`OutputError`), or a path that cannot be used (:class:`InputError`)."""
-    reason = exc.strerror or str(exc)
+    # a machine error in the system's words for its errno (pyarrow's strerror reads "error
+    # writing bytes to file. Detail: [errno 28] No space left on device")
+    reason = (os.strerror(exc.errno) if exc.errno in MACHINE_ERRNOS else
+              exc.strerror or str(exc))
     reason = reason[:1].lower() + reason[1:]
     if exc.errno in MACHINE_ERRNOS:
         return OutputError(path, reason)

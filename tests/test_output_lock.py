@@ -84,7 +84,7 @@ def held(target: Path) -> Iterator[int]:
         proc.wait()
 
 
-@pytest.mark.parametrize("command", ["run", "study", "tune", "world import"])
+@pytest.mark.parametrize("command", ["run", "study", "tune", "falsify", "world import"])
 def test_a_second_writer_is_refused_in_one_line_naming_the_first(
         tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str) -> None:
     from test_outputs_disk import commands

@@ -110,7 +110,7 @@ def test_a_full_disk_leaves_the_earlier_result_as_it_was(disk: Disk) -> None:
     assert sorted(p.name for p in folder.iterdir()) == ["filler", "run"]
 
 
-@pytest.mark.parametrize("command", ["study", "tune", "world import"])
+@pytest.mark.parametrize("command", ["study", "tune", "falsify", "world import"])
 def test_a_study_tune_or_import_on_a_full_disk_is_one_line_exit_74(
         disk: Disk, tmp_path: Path, command: str) -> None:
     full = disk("32k")
@@ -118,11 +118,16 @@ def test_a_study_tune_or_import_on_a_full_disk_is_one_line_exit_74(
                       "--workers", "1", "--out", str(full / "out"), "--quiet"],
             "tune": ["tune", str(small_tune(tmp_path)), "--workers", "1", "--out",
                      str(full / "out"), "--quiet"],
+            "falsify": FALSIFY + ["--out", str(full / "out")],
             "world import": ["world", "import", str(SCAN), "-o", str(full / "w.yaml")]}
     done = astralis(*args[command])
     assert done.returncode == EXIT_OUTPUT, done.stderr
     assert "no space left on device" in one_line(done.stderr)
     assert list(full.iterdir()) == []
+
+
+FALSIFY = ["falsify", str(MISSION), "--trials", "2", "--batch", "2", "--no-baseline",
+           "--workers", "1", "--quiet"]
 
 
 def small_tune(folder: Path) -> Path:
@@ -144,10 +149,11 @@ def commands(out: Path, tmp_path: Path) -> dict[str, list[str]]:
                       "--workers", "1", "--out", str(out), "--quiet"],
             "tune": ["tune", str(small_tune(tmp_path)), "--workers", "1", "--out", str(out),
                      "--quiet"],
+            "falsify": FALSIFY + ["--out", str(out)],
             "world import": ["world", "import", str(SCAN), "-o", str(out) + ".yaml"]}
 
 
-@pytest.mark.parametrize("command", ["run", "study", "tune", "world import"])
+@pytest.mark.parametrize("command", ["run", "study", "tune", "falsify", "world import"])
 @pytest.mark.parametrize("place", ["read-only", "under a file", "/proc"])
 def test_an_output_folder_that_cannot_be_written_is_one_line_exit_2(
         disk: Disk, tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str,
