@@ -157,7 +157,8 @@ def write_plots(result: FalsifyResult, folder: Path, ranks: dict[str, float]) ->
                        [math.nan if v is None else v for v in scores], s=6, color=colour,
                        alpha=0.35)
     ax.set_xlabel("trials")
-    ax.set_ylabel(f"worst so far: {score_label(result)}")
+    ax.set_ylabel("worst score so far (dots: each trial)")
+    ax.set_title(f"score: {score_label(result)}", fontsize=9)
     ax.legend()
     fig.tight_layout()
     fig.savefig(folder / "convergence.png", dpi=110)
