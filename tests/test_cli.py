@@ -381,7 +381,8 @@ def test_stdout_holds_only_our_lines_with_pybullet(tmp_path: Path) -> None:
     assert lines[0].startswith("urban_search (seed 42, physics): ")
     assert lines[-1] == f"outputs: {tmp_path / 'run'}/"
     lines = imp.stdout.splitlines()
-    assert lines[0].startswith(f"{tmp_path / 'w' / 'blocks.yaml'}: 24 triangles, ")
+    words = " ".join(imp.stdout.split())  # a long tmp_path (pytest-xdist's) wraps the line
+    assert words.startswith(f"{tmp_path / 'w' / 'blocks.yaml'}: 24 triangles, ")
     assert lines[-1] == "wrote blocks.blocks.npz, blocks.mesh.obj, blocks.parts.obj, blocks.yaml"
     for text in (run.stdout, imp.stdout):
         assert "pybullet" not in text.lower() and "build time" not in text
