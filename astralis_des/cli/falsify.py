@@ -8,7 +8,7 @@ from typing import Any
 
 from astralis_des.cli.options import add_out, add_quiet, positive
 
-SAMPLER_NAMES = "tpe, tpe-independent, random, qmc, cmaes"  # falsify.SAMPLERS
+SAMPLER_NAMES = "tpe, tpe-independent, tpe-multivariate, random, qmc, cmaes"  # falsify.SAMPLERS
 
 
 def add_falsify_parser(sub: Any) -> None:
