@@ -194,6 +194,20 @@ def test_social_metrics_of_a_robot_passing_a_person() -> None:
     assert got["human_close_s"] == pytest.approx(2 * np.sqrt(1.2**2 - 1.0), abs=0.1)
 
 
+def test_a_run_ended_within_its_first_tenth_of_a_second_has_its_metrics() -> None:
+    """A served mission ended at t = 0.01 s (the API's end): its metrics have no closest
+    approach to measure, not a traceback in the server's thread (np.gradient of one sample)."""
+    mission = load_mission(ROOT / "missions" / "urban_search.yaml").with_changes(
+        outputs={"events": False, "summary": False, "recording": False})
+    sim = Simulation(mission)
+    sim.advance(until=0.01)
+    result = sim.finish()
+    assert result.outcome == "interrupted" and result.end_time == pytest.approx(0.01)
+    assert result.metrics["human_min_distance"] is None
+    assert result.metrics["human_close_s"] is None
+    assert result.metrics["time_to_find"] is None and result.metrics["found"] is False
+
+
 def test_allocation_metrics_of_the_default_mission_match_its_event_log(tmp_path: Path) -> None:
     from astralis_des.simulation.metrics import allocation_metrics
 

@@ -124,9 +124,9 @@ def social(sim: Run, end: float) -> dict[str, float | None]:
     """The closest approach of a moving robot to a person, and seconds within ``CLOSE``."""
     people = [rid for rid, r in sim.robots.items() if KIND_DEFAULTS[r.kind].person]
     others = [rid for rid, r in sim.robots.items() if not KIND_DEFAULTS[r.kind].person]
-    if not people or not others or end <= 0:
-        return {"human_min_distance": None, "human_close_s": None}
     times = np.arange(0.0, end + STEP / 2, STEP)
+    if not people or not others or len(times) < 2:  # a speed needs two samples
+        return {"human_min_distance": None, "human_close_s": None}
     where = {rid: _track(sim, rid, times, end) for rid in sim.robots}
     nearest, close = np.inf, 0.0
     for person in people:
