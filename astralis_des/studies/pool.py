@@ -62,14 +62,6 @@ def _orphan_proof(parent: int) -> None:
         os._exit(0)
 
 
-def quiet_missions() -> None:
-    """A worker's missions keep their warnings (a UAV landing where it is, a planner's
-    fallback) to themselves: hundreds of missions would bury the progress and the study's own
-    warnings (a failed scenario, with its seed to replay it with ``--replay``)."""
-    logging.getLogger("astralis_des").setLevel(logging.ERROR)
-    logging.getLogger("astralis_des.studies").setLevel(logging.WARNING)
-
-
 def _serve(conn: Connection, base: Study, parent: int) -> None:
     """A worker: scenarios of ``base`` (or of ``base.with_changes(**changes)``, made once per
     changes) until told to stop, or until its parent is gone."""
@@ -77,7 +69,6 @@ def _serve(conn: Connection, base: Study, parent: int) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     _orphan_proof(parent)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)
-    quiet_missions()
     made: tuple[dict[str, Any], Study] | None = None
     while True:
         try:

@@ -9,7 +9,8 @@ from __future__ import annotations
 import logging
 import math
 import traceback
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -77,13 +78,31 @@ def failed_scenario(study: Study, index: int, reason: str) -> ChunkResult:
 
 
 def run_chunk(study: Study, indices: Sequence[int], recordings: Path | None) -> ChunkResult:
+    """Scenarios ``indices`` (what every backend runs, in a worker or in this process)."""
     done = ChunkResult(0, [], [])
-    for index in indices:
-        one = run_scenario(study, index, recordings=recordings)
-        done.scenarios += 1
-        done.rows += one.rows
-        done.failures += one.failures
+    with quiet_missions():
+        for index in indices:
+            one = run_scenario(study, index, recordings=recordings)
+            done.scenarios += 1
+            done.rows += one.rows
+            done.failures += one.failures
     return done
+
+
+@contextmanager
+def quiet_missions() -> Iterator[None]:
+    """The missions of a chunk keep their warnings (a UAV landing where it is, a planner's
+    fallback) to themselves: hundreds of missions would bury the progress and the study's own
+    warnings (a failed scenario, with its seed to ``--replay`` it, which shows them)."""
+    package, studies = logging.getLogger("astralis_des"), logging.getLogger("astralis_des.studies")
+    levels = package.level, studies.level
+    package.setLevel(logging.ERROR)
+    studies.setLevel(logging.WARNING)
+    try:
+        yield
+    finally:
+        package.setLevel(levels[0])
+        studies.setLevel(levels[1])
 
 
 def chunks(n: int, workers: int) -> list[list[int]]:
