@@ -34,7 +34,8 @@ from astralis_des.errors import suggest
 from astralis_des.kinds import TARGET_HEIGHT
 from astralis_des.mission.draws import AVATAR_VALUES
 from astralis_des.mission.loader import Mission
-from astralis_des.mission.spec import Finite, Sound, Strict
+from astralis_des.mission.spec import Sound, Strict
+from astralis_des.studies.tune_spec import Interval
 from astralis_des.validation import validate
 from astralis_des.world.placement import shown
 from astralis_des.world.spots import free_spots
@@ -50,21 +51,6 @@ ROOM_PROPS = ("risk", "messiness", "sound")
 AvatarKey = Literal["activity", "color", "gender", "height", "tied_to_chair"]
 SHAPING: tuple[AvatarKey, ...] = ("activity", "height")
 COMM_RANGE = (5.0, 100.0)  # m: CBBA's range searched when the space file says nothing
-
-
-class Range(Strict):
-    low: Finite
-    high: Finite
-    log: bool = False
-
-    @model_validator(mode="after")
-    def _ordered(self) -> Range:
-        if not self.low < self.high:
-            raise ValueError(f"empty or inverted range: low {self.low:g} must be below high "
-                             f"{self.high:g}")
-        if self.log and self.low <= 0:
-            raise ValueError("a log range needs low above 0")
-        return self
 
 
 class IntRange(Strict):
@@ -91,14 +77,14 @@ class TargetSpace(Strict):
 class RoomsSpace(Strict):
     rooms: list[str] | None = Field(None, min_length=1,
                                     description="default: the mission's searched rooms")
-    risk: Range | Literal[False] = Range(low=0.0, high=1.0)
-    messiness: Range | Literal[False] = Range(low=0.0, high=1.0)
+    risk: Interval | Literal[False] = Interval(low=0.0, high=1.0)
+    messiness: Interval | Literal[False] = Interval(low=0.0, high=1.0)
     sound: tuple[Sound, ...] | Literal[False] = False  # changes nothing a run does (shown)
 
 
 class FaultSpace(Strict):
     robots: list[str] | None = Field(None, description="default: every member")
-    at: Range | None = Field(None, description="s; default: until the base mission ends")
+    at: Interval | None = Field(None, description="s; default: until the base mission ends")
     none: bool = Field(True, description="no fault at all is one of the choices")
 
 
@@ -114,7 +100,7 @@ class SpaceSpec(Strict):
     faults: FaultSpace | Literal[False] = Field(default_factory=FaultSpace)
     movers: IntRange | Literal[False] | None = None  # None: 0 to 4 where there are corridors
     starts: StartSpace | Literal[False] = Field(default_factory=StartSpace)
-    comm_range: Range | Literal[False] | None = None  # None: searched when a strategy is cbba
+    comm_range: Interval | Literal[False] | None = None  # None: searched when a strategy is cbba
     seed: IntRange | Literal[False] = False
 
 
@@ -305,7 +291,7 @@ def build_space(spec: SpaceSpec, doc: LocatedYaml, mission: Mission, strategies:
         ranges = {}
         for prop in ROOM_PROPS:
             bound = getattr(props, prop)
-            if isinstance(bound, Range):
+            if isinstance(bound, Interval):
                 _within(doc, ("rooms", prop), bound, 0.0, 1.0)
                 ranges[prop] = Dim(low=bound.low, high=bound.high)
             elif bound is not False:
@@ -319,7 +305,7 @@ def build_space(spec: SpaceSpec, doc: LocatedYaml, mission: Mission, strategies:
         robots = robots_at(("faults", "robots"), spec.faults.robots)
         choices = ([NO_FAULT] if spec.faults.none else []) + robots
         if len(choices) > 1 or (choices and choices[0] != NO_FAULT):
-            at = spec.faults.at or Range(low=0.0, high=max(fault_until, 1.0))
+            at = spec.faults.at or Interval(low=0.0, high=max(fault_until, 1.0))
             _within(doc, ("faults", "at"), at, 0.0, given.time_limit)
             dims["fault.robot"] = Dim(tuple(choices))
             dims["fault.at"] = Dim(low=at.low, high=at.high)
@@ -343,8 +329,8 @@ def build_space(spec: SpaceSpec, doc: LocatedYaml, mission: Mission, strategies:
                 dims[f"start.{member.id}"] = Dim(tuple(range(len(spots))))
     comm = spec.comm_range
     if comm is None and "cbba" in strategies:
-        comm = Range(low=COMM_RANGE[0], high=COMM_RANGE[1], log=True)
-    if isinstance(comm, Range):
+        comm = Interval(low=COMM_RANGE[0], high=COMM_RANGE[1], log=True)
+    if isinstance(comm, Interval):
         _within(doc, ("comm_range",), comm, 1e-3, 1e6)
         dims["comm_range"] = Dim(low=comm.low, high=comm.high, log=comm.log)
     if not dims:
@@ -353,7 +339,7 @@ def build_space(spec: SpaceSpec, doc: LocatedYaml, mission: Mission, strategies:
     return Space(mission, dims, starts)
 
 
-def _within(doc: LocatedYaml, path: KeyPath, bound: Range | IntRange, low: float,
+def _within(doc: LocatedYaml, path: KeyPath, bound: Interval | IntRange, low: float,
             high: float) -> None:
     if bound.low < low or bound.high > high:
         raise doc.error(path, f"the range {bound.low:g} to {bound.high:g} goes beyond "

@@ -38,22 +38,27 @@ from astralis_des.yamlio import LocatedYaml, load_yaml
 MAX_TRIALS = 100_000
 
 
-class Bound(Strict):
-    """A number between ``low`` and ``high`` (on a log scale, or in steps of ``step``)."""
+class Interval(Strict):
+    """A number between ``low`` and ``high`` (on a log scale): a falsify space's range."""
 
     low: Finite
     high: Finite
     log: bool = False
-    step: Finite | None = Field(None, gt=0)
 
     @model_validator(mode="after")
-    def _ordered(self) -> Bound:
+    def _ordered(self) -> Interval:
         if not self.low < self.high:
             raise ValueError(f"empty or inverted bounds: low {self.low:g} must be below high "
                              f"{self.high:g}")
         if self.log and self.low <= 0:
             raise ValueError(f"a log scale needs low > 0 (got {self.low:g})")
         return self
+
+
+class Bound(Interval):
+    """A tune's parameter: an interval, or its values in steps of ``step``."""
+
+    step: Finite | None = Field(None, gt=0)
 
 
 class Target(Strict):
