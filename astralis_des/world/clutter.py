@@ -9,28 +9,19 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from astralis_des.errors import suggest
-from astralis_des.memo import kept
 from astralis_des.streams import stream
 from astralis_des.world.catalogue import Catalogue, agree, avatar_size, default_catalogue
 from astralis_des.world.freespace import BoolArray, FreeSpace, room_free_space
 from astralis_des.world.geometry import Box
-from astralis_des.world.grids import (
-    backs_onto_wall,
-    erode,
-    eroded_after,
-    padded,
-    reachable,
-    summed,
-    walkable,
-    window,
-)
+from astralis_des.world.grids import backs_onto_wall, summed, window
 from astralis_des.world.model import Room, World
+from astralis_des.world.placing import Occupancy
 
 ATTEMPTS = 30  # spots tried per item before it is skipped
 AVATAR = "avatar"
@@ -70,63 +61,6 @@ class Spot:
     center: tuple[float, float]
     extent: tuple[float, float]
     yaw: float
-
-
-@dataclass
-class Occupancy:
-    """What is already taken on a room's grid, and what is reachable around it."""
-
-    taken: BoolArray  # cells under a footprint
-    halo: BoolArray  # cells under a footprint grown by its clearance
-    keepout: BoolArray  # cells kept empty (in front of the door)
-    reach: BoolArray  # free cells a robot's centre can reach from the door
-    walk_eroded: BoolArray  # where the centre of a robot as wide as the passage fits
-    # by a clearance in cells: the cells within it of a taken one, kept up to date as
-    # footprints are stamped (what a footprint's window must not hold)
-    near: dict[int, BoolArray] = field(default_factory=dict)
-
-    @classmethod
-    def empty(cls, space: FreeSpace, keepout: BoolArray, passage: float) -> Occupancy:
-        """Nothing placed yet; the empty room's reachability is worked out once per room
-        and passage (its arrays are replaced, never changed, as footprints are placed)."""
-        taken = np.zeros(space.shape, dtype=bool)
-        reach: dict[float, tuple[BoolArray, BoolArray]] = kept(space, "empty_reach", 64)
-        if passage not in reach:
-            reach[passage] = _reach(space, taken, passage)
-            for array in reach[passage]:
-                array.setflags(write=False)
-        return cls(taken, taken.copy(), keepout, *reach[passage])
-
-    def settle(self, space: FreeSpace, passage: float) -> None:
-        """Reachability again after footprints were stamped by hand."""
-        self.reach, self.walk_eroded = _reach(space, self.taken, passage)
-
-    def near_taken(self, grow: int) -> BoolArray:
-        """Cells within ``grow`` cells (a square) of a taken one."""
-        if grow not in self.near:
-            table = summed(padded(self.taken, grow, False))
-            self.near[grow] = window(table, 2 * grow + 1, 2 * grow + 1) > 0
-        return self.near[grow]
-
-    def saved(self) -> Occupancy:
-        """A copy to :meth:`restore` (a footprint tried and given up)."""
-        return replace(self, taken=self.taken.copy(), halo=self.halo.copy(),
-                       near={g: a.copy() for g, a in self.near.items()})
-
-    def restore(self, saved: Occupancy) -> None:
-        self.taken, self.halo, self.near = saved.taken, saved.halo, saved.near
-
-    def stamp(self, space: FreeSpace, box: Box, clearance: float) -> None:
-        rows, cols = space.cells(box.lo, box.hi)
-        self.taken[rows, cols] = True
-        (i0, i1), (j0, j1) = (rows.start, rows.stop), (cols.start, cols.stop)
-        if i0 < i1 and j0 < j1:  # taken is the union of the stamped rectangles
-            for g, near in self.near.items():
-                near[max(i0 - g, 0):i1 + g, max(j0 - g, 0):j1 + g] = True
-        grow = (clearance, clearance, 0.0)
-        lo = tuple(a - g for a, g in zip(box.lo, grow, strict=True))
-        hi = tuple(a + g for a, g in zip(box.hi, grow, strict=True))
-        self.halo[space.cells(lo, hi)] = True
 
 
 def place_room(world: World, room_id: str, messiness: float, rng: np.random.Generator,
@@ -204,9 +138,9 @@ def furnish(world: World, room_id: str, messiness: float, seed: int, index: int,
     """
     memo = world.memo("furnished", MEMO_ROOMS)
     key = (room_id, messiness, seed, index)
-    kept = memo.get(key)
-    if kept is not None and kept[0] is catalogue:
-        return kept[1]
+    found = memo.get(key)
+    if found is not None and found[0] is catalogue:
+        return found[1]
     clutter = place_room(world, room_id, messiness, stream(seed, "clutter", index), catalogue)
     memo[key] = (catalogue, clutter)
     return clutter
@@ -275,16 +209,8 @@ def place_in(space: FreeSpace, occupied: Occupancy, footprint: Sequence[float],
         layout, corners, width = candidates[which]
         offset = int(pick - (bounds[which - 1] if which else 0))
         spot = layout.spot(space, np.divmod(corners[offset], width))
-        box = _footprint_box(spot)
-        before = occupied.saved()
-        occupied.stamp(space, box, clearance)
-        walk_eroded = eroded_after(space, occupied.taken, occupied.walk_eroded, before.taken,
-                                   space.cells(box.lo, box.hi), passage / 2 / space.cell)
-        eroded, reach = reachable(space, occupied.taken, passage, walk_eroded)
-        if not (eroded & occupied.reach & ~reach).any():
-            occupied.reach, occupied.walk_eroded = reach, walk_eroded
+        if occupied.try_stamp(space, _footprint_box(spot), clearance, passage):
             return spot
-        occupied.restore(before)
     return "every spot tried cuts off free floor from the door"
 
 
@@ -343,13 +269,6 @@ def _candidates(space: FreeSpace, occupied: Occupancy, w: float, d: float, again
         if len(corners):
             found.append((layout, corners, fits.shape[1]))
     return found
-
-
-def _reach(space: FreeSpace, taken: BoolArray, passage: float) -> tuple[BoolArray, BoolArray]:
-    """The cells reachable from the door, and the walkable floor eroded by half the passage
-    (what placing the next footprint updates around it)."""
-    walk_eroded = erode(walkable(space, taken), passage / 2 / space.cell)
-    return reachable(space, taken, passage, walk_eroded)[1], walk_eroded
 
 
 def _footprint_box(spot: Spot) -> Box:

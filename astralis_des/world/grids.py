@@ -121,19 +121,6 @@ def reachable(space: FreeSpace, taken: BoolArray, passage: float,
     return eroded, from_door[labels]
 
 
-def eroded_after(space: FreeSpace, taken: BoolArray, walk_eroded: BoolArray,
-                 taken_before: BoolArray, stamped: Cells, radius: float) -> BoolArray:
-    """The walkable floor eroded by ``radius`` cells once the cells ``stamped`` are taken
-    (``taken``: after, ``taken_before``: before; ``walk_eroded``: the erosion before): from
-    the erosion before, as the walk lost the whole rectangle (the usual case: a spot on the
-    room's free floor), or by eroding around it again."""
-    was = (space.free & ~taken_before)[stamped]
-    outside = (space.open_floor & ~space.inside)[stamped]
-    if (was & ~outside).all():
-        return erode_without(walk_eroded, radius, stamped)
-    return erode_near(walkable(space, taken), radius, stamped, walk_eroded)
-
-
 def backs_onto_wall(space: FreeSpace, wall: int, kx: int, ky: int) -> BoolArray:
     """Corners whose ``kx`` by ``ky`` window's back row or column lies wholly along the wall
     on side ``wall`` (the room's own: kept on its free space, by wall and window)."""
