@@ -87,12 +87,15 @@ class GeometricSensor:
                                       count)
         return None
 
-    def _sight(self, p0: FloatArray, p1: FloatArray) -> np.ndarray:
+    def _sight(self, p0: FloatArray, p1: FloatArray,
+               rooms: list[str] | None = None) -> np.ndarray:
         """Where nothing lies between ``p0[m]`` and ``p1[m]``. Looking into a room is what
         furnishes it (in kinematic fidelity, the team's first look at it): the rooms the
-        lines start or end in are furnished first, then the scene is asked."""
+        lines start or end in (``rooms``, when the caller knows them) are furnished first,
+        then the scene is asked."""
         scene = self.scene
-        rooms = scene.rooms_at(np.concatenate([np.atleast_2d(p0), np.atleast_2d(p1)]))
+        if rooms is None:
+            rooms = scene.rooms_at(np.concatenate([np.atleast_2d(p0), np.atleast_2d(p1)]))
         scene.furnish(rooms)
         return scene.line_of_sight(p0, p1, rooms)
 
@@ -111,7 +114,7 @@ class GeometricSensor:
         robot looks into the room: it is furnished first if it was not yet."""
         if robot.view is None:
             return 0.0
-        full = floor_cells(room)
+        full, alone = self._floor(room)
         self.scene.furnish([room.id])  # looking into a room is what furnishes it
         boxes = self.scene.still_boxes([room.id])
         keep = np.ones(len(full), dtype=bool)
@@ -124,18 +127,36 @@ class GeometricSensor:
         pts, heads = _sample_path(robot, np.asarray(points, dtype=float), headings)
         size = np.asarray(self.target.size, dtype=float)
         if not _within(self.scene.world, room, pts):  # another room's furniture may matter
-            return self._coverage(view, pts, heads, full, keep, boxes, size, room)
+            return self._coverage(view, pts, heads, full, keep, boxes, size, room, None)
         # the answer depends on these alone: kept on the world (a tune's next trial, a study's
         # next variant flies the same sweep of the same furnished room)
         digest = _digest(pts, heads, boxes, size)
         memo = self.scene.world.memo("coverage", MEMO_SWEEPS)
         key = (view, room.id, len(pts), len(boxes), digest)
         if key not in memo:
-            memo[key] = self._coverage(view, pts, heads, full, keep, boxes, size, room)
+            # the sight lines start and end in this room alone (its floor cells lie in no
+            # other room): no need to find the rooms of their ends again
+            memo[key] = self._coverage(view, pts, heads, full, keep, boxes, size, room,
+                                       [room.id] if alone else None)
         return float(memo[key])
 
+    def _floor(self, room: Room) -> tuple[FloatArray, bool]:
+        """The room's :func:`floor_cells` (read-only), and whether they all lie in it and in
+        no other room: once per world and room."""
+        memo = self.scene.world.memo("floor_cells", 4096)
+        if room.id not in memo:
+            full = floor_cells(room)
+            full.setflags(write=False)
+            lo, hi = np.asarray(room.box.lo), np.asarray(room.box.hi)
+            alone = bool(np.all((full >= lo) & (full <= hi))) and \
+                self.scene.rooms_at(full) == [room.id]
+            memo[room.id] = (full, alone)
+        found: tuple[FloatArray, bool] = memo[room.id]
+        return found
+
     def _coverage(self, view: View, pts: FloatArray, heads: FloatArray, full: FloatArray,
-                  keep: np.ndarray, boxes: FloatArray, size: FloatArray, room: Room) -> float:
+                  keep: np.ndarray, boxes: FloatArray, size: FloatArray, room: Room,
+                  rooms: list[str] | None) -> float:
         """A cell (of ``full[keep]``) is seen when some point of the path shows a target
         there with enough pixels and in sight. The path's points are taken in ``PASSES``
         interleaved passes (every ``PASSES``-th point, then the next...), each judging only
@@ -170,7 +191,7 @@ class GeometricSensor:
                 seen[ci[in_room[pi]]] = True
             left = ~seen[ci]
             if left.any():
-                clear = self._sight(pts[pi[left]], cells[ci[left]])
+                clear = self._sight(pts[pi[left]], cells[ci[left]], rooms)
                 seen[ci[left][clear]] = True
         return float(seen.mean())
 

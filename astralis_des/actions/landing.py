@@ -12,6 +12,7 @@ body clears, else by a route.
 from __future__ import annotations
 
 import logging
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -68,9 +69,9 @@ def landing_way(ctx: Context, robot: Robot) -> FloatArray:
         searches.append(_grid(ctx, here, door, floor, None))
     else:  # none near (over the stair hall's well): farther
         searches.append(_grid(ctx, here, here, floor, None, 2 * LANDING_FAR))
-    for spots in searches:
-        spots = spots[_free(taken, spots, floor) &
-                      ~ctx.world.near_doorway(spots, floor, DOOR_KEEP)]
+    for grid in searches:
+        spots = grid.spots[_free_on(taken, grid, floor)]
+        spots = spots[~ctx.world.near_doorway(spots, floor, DOOR_KEEP)]
         spots = spots[_supported(ctx, spots, floor)]
         way = _nearest_way(ctx, robot, here, spots, solid)
         if way is not None:
@@ -173,8 +174,25 @@ def _in(ctx: Context, spot: FloatArray, floor: float, room: Room | None) -> bool
     return (there.id if there else None) == (room.id if room else None)
 
 
+@dataclass(frozen=True)
+class _Grid:
+    """Spots ``LANDING_GRID`` apart at height ``z``: the grid ``xs`` by ``ys`` (``[i, j]``
+    raveled), those of ``where`` only (all if None)."""
+
+    xs: FloatArray
+    ys: FloatArray
+    z: float
+    where: np.ndarray | None
+
+    @property
+    def spots(self) -> FloatArray:
+        gx, gy = np.meshgrid(self.xs, self.ys, indexing="ij")
+        spots = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, self.z)])
+        return spots if self.where is None else spots[self.where]
+
+
 def _grid(ctx: Context, here: FloatArray, centre: FloatArray, floor: float,
-          room: Room | None, far: float = LANDING_FAR) -> FloatArray:
+          room: Room | None, far: float = LANDING_FAR) -> _Grid:
     """Spots ``LANDING_GRID`` apart at ``here``'s height: over the room, else within
     ``far`` of ``centre``, outside every room and over the same floor."""
     if room is not None:
@@ -184,18 +202,31 @@ def _grid(ctx: Context, here: FloatArray, centre: FloatArray, floor: float,
         lo, hi = centre[:2] - far, centre[:2] + far
     xs = np.arange(lo[0], hi[0] + 1e-9, LANDING_GRID)
     ys = np.arange(lo[1], hi[1] + 1e-9, LANDING_GRID)
-    gx, gy = np.meshgrid(xs, ys, indexing="ij")
-    spots = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, here[2])])
     if room is not None:
-        return spots
+        return _Grid(xs, ys, float(here[2]), None)
     boxes = ctx.world.room_boxes
-    at = np.column_stack([spots[:, :2], np.full(len(spots), floor + 0.5)])
-    inside = np.zeros(len(spots), dtype=bool)
+    level = floor + 0.5
+    inside = np.zeros((len(xs), len(ys)), dtype=bool)
     for k in np.flatnonzero(np.all((boxes[:, 0, :2] <= hi) & (boxes[:, 1, :2] >= lo), axis=1)):
-        inside |= np.all((at >= boxes[k, 0]) & (at <= boxes[k, 1]), axis=1)
-    spots = spots[~inside]
-    same = np.abs(ctx.world.floors_below(spots) - floor) < 0.05
-    return spots[same] if len(spots) else spots
+        if boxes[k, 0, 2] <= level <= boxes[k, 1, 2]:  # a box test, an axis at a time
+            inside |= np.outer((xs >= boxes[k, 0, 0]) & (xs <= boxes[k, 1, 0]),
+                               (ys >= boxes[k, 0, 1]) & (ys <= boxes[k, 1, 1]))
+    where = ~inside.ravel()
+    grid = _Grid(xs, ys, float(here[2]), where)
+    if where.any():
+        where[where] = np.abs(ctx.world.floors_below(grid.spots) - floor) < 0.05
+    return grid
+
+
+def _free_on(boxes: FloatArray, grid: _Grid, floor: float) -> np.ndarray:
+    """:func:`_free` of the grid's spots: a box meets a spot's square where it meets its
+    column (x) and its row (y), at the grid's height."""
+    xs, ys = grid.xs, grid.ys
+    boxes = boxes[(boxes[:, 0, 2] < grid.z) & (boxes[:, 1, 2] > floor + 0.02)]
+    cols = (boxes[:, 0, 0, None] < xs + LANDING_CLEAR) & (boxes[:, 1, 0, None] > xs - LANDING_CLEAR)
+    rows = (boxes[:, 0, 1, None] < ys + LANDING_CLEAR) & (boxes[:, 1, 1, None] > ys - LANDING_CLEAR)
+    free = ~((cols.T.astype(float) @ rows.astype(float)) > 0).ravel()
+    return free if grid.where is None else free[grid.where]
 
 
 def _clears(solid: FloatArray, here: FloatArray, spot: FloatArray) -> bool:
