@@ -18,8 +18,10 @@ What is kept, on what (``kept(owner, NAME)``):
 - on a world's **router**: ``routes`` (waypoints, by ends and kind, read-only) and
   ``places`` (the place of a point);
 - on a **voxel map**: ``occupied_points`` (its occupied cells' centres);
-- on a room's **free space**: ``empty_reach`` (where a robot reaches in the empty room) and
-  ``wall_backs`` (where a footprint's back lies along a wall, by wall and footprint).
+- on a room's **free space**: ``empty_reach`` (where a robot reaches in the empty room),
+  ``wall_backs`` (where a footprint's back lies along a wall, by wall and footprint) and
+  ``rings`` (the cells round a footprint grown by half the passage, by its size; the door's
+  bounds);
 
 Elsewhere, once per process and by value (``functools``): the packaged clutter catalogue, the
 ROS 2 message types, a camera's swath by view and height, a catalogue without its furniture,
@@ -40,7 +42,7 @@ from typing import Any
 
 NAMES = frozenset({"voxel_map", "block_field", "free_space", "furnished", "coverage",
                    "floor_cells", "first_pass", "sky", "ducked", "occupied_points",
-                   "empty_reach", "wall_backs", "routes", "places"})
+                   "empty_reach", "wall_backs", "rings", "routes", "places"})
 
 
 def kept(owner: object, name: str, limit: int | None = None) -> dict[Any, Any]:

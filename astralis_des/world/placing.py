@@ -1,19 +1,22 @@
 """What is taken on a room's grid while it is furnished, and whether a footprint cuts floor off.
 
 A footprint is kept when every free cell a robot as wide as the passage reached from the door
-before is still reached (or lies under the footprint, grown by half the passage). A footprint
-given up is undone from what its stamp overwrote (a few small windows), not from copies of
-every grid.
+before is still reached (or lies under the footprint, grown by half the passage). Labelling the
+grid's regions again answers that; most footprints are settled without, by the ring of cells
+round what they take (:func:`_keeps_reach`), with the same answer and the same cells reached.
+A footprint given up is undone from what its stamp overwrote, not from copies of every grid.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import ndimage
 
 from astralis_des.memo import kept
-from astralis_des.world.freespace import BoolArray, FreeSpace
+from astralis_des.world.freespace import CROSS, BoolArray, FreeSpace, IntArray
 from astralis_des.world.geometry import Box
 from astralis_des.world.grids import (
     Cells,
@@ -99,6 +102,10 @@ class Occupancy:
         outside = space.open_floor[stamped] & ~space.inside[stamped]
         if (was & ~outside).all():  # the walk lost the whole rectangle (the usual case)
             walk_eroded = erode_without(self.walk_eroded, radius, stamped)
+            if _keeps_reach(space, self.reach, radius, stamped):
+                self.reach = erode_without(self.reach, radius, stamped)
+                self.walk_eroded = walk_eroded
+                return True
         else:
             walk_eroded = erode_near(walkable(space, self.taken), radius, stamped,
                                      self.walk_eroded)
@@ -113,6 +120,91 @@ class Occupancy:
 def _set(undo: Undo, array: BoolArray, cells: Cells) -> None:
     undo.append((array, cells, array[cells].copy()))
     array[cells] = True
+
+
+@dataclass(frozen=True)
+class _Ring:
+    """The cells round a rectangle grown as :func:`erode_without` grows it, which touch it
+    (by a side or a corner): a closed path, each cell joined to the next by a side."""
+
+    rows: IntArray  # offsets from the rectangle's first cell
+    cols: IntArray
+    flat: IntArray  # the same on the room's grid, raveled
+    ends: tuple[IntArray, IntArray]  # the path's steps: pairs of indices into rows, cols
+    grow: int  # cells the rectangle grows by, at most
+
+
+def _ring(space: FreeSpace, kx: int, ky: int, radius: float) -> _Ring | None:
+    """The ring round a ``kx`` by ``ky`` rectangle grown by ``radius`` cells (kept on the room's
+    free space, by size), or None where its cells make no simple closed path."""
+    rings: dict[object, _Ring | None] = kept(space, "rings", 4096)
+    key = (kx, ky, radius)
+    if key not in rings:
+        rings[key] = _make_ring(kx, ky, radius, space.shape[1])
+    return rings[key]
+
+
+def _make_ring(kx: int, ky: int, radius: float, width: int) -> _Ring | None:
+    grow = math.floor(radius + 1e-9)
+    o = grow + 2
+    grown = np.zeros((kx + 2 * o, ky + 2 * o), dtype=bool)
+    for di in range(grow + 1):  # as erode_without clears them
+        h = math.floor(math.sqrt(radius * radius - di * di) + 1e-9)
+        grown[o - di:o + kx + di, o - h:o + ky + h] = True
+    ring = ndimage.binary_dilation(grown, np.ones((3, 3), dtype=bool)) & ~grown
+    index = np.full(ring.shape, -1)
+    rows, cols = np.nonzero(ring)
+    index[rows, cols] = np.arange(len(rows))
+    steps = [(index[:-1, :][ring[:-1, :] & ring[1:, :]], index[1:, :][ring[:-1, :] & ring[1:, :]]),
+             (index[:, :-1][ring[:, :-1] & ring[:, 1:]], index[:, 1:][ring[:, :-1] & ring[:, 1:]])]
+    first = np.concatenate([a for a, _ in steps])
+    second = np.concatenate([b for _, b in steps])
+    degree = np.bincount(np.concatenate([first, second]), minlength=len(rows))
+    if not (degree == 2).all() or ndimage.label(ring, CROSS)[1] != 1:
+        return None
+    rows, cols = rows - o, cols - o
+    return _Ring(rows, cols, rows * width + cols, (first, second), grow)
+
+
+def _keeps_reach(space: FreeSpace, reach: BoolArray, radius: float, lost: Cells) -> bool:
+    """Whether every cell ``reach``ed from the door stays reached but those :func:`erode_without`
+    clears round the rectangle ``lost`` (the walk lost it, so these are all the eroded floor
+    loses). Sure when no door cell lies there and the reached cells of the ring round them
+    make one stretch of it (or the whole ring): a way from a reached cell to the door through
+    the cleared ones enters and leaves them beside the ring, and goes round along it instead.
+    False: not sure (label the grid again)."""
+    (i0, i1), (j0, j1) = (lost[0].start, lost[0].stop), (lost[1].start, lost[1].stop)
+    if i0 >= i1 or j0 >= j1:
+        return False
+    ring = _ring(space, i1 - i0, j1 - j0, radius)
+    if ring is None:
+        return False
+    door = _door_bounds(space)
+    g = ring.grow
+    if door is not None and i0 - g <= door[1] and door[0] < i1 + g and j0 - g <= door[3] \
+            and door[2] < j1 + g:
+        return False
+    nx, ny = reach.shape
+    if i0 - g > 0 and i1 + g < nx and j0 - g > 0 and j1 + g < ny:  # the ring on the grid
+        held = reach.ravel()[ring.flat + (i0 * ny + j0)]
+    else:
+        rows, cols = ring.rows + i0, ring.cols + j0
+        on_grid = (rows >= 0) & (rows < nx) & (cols >= 0) & (cols < ny)
+        held = reach[np.minimum(np.maximum(rows, 0), nx - 1),
+                     np.minimum(np.maximum(cols, 0), ny - 1)] & on_grid
+    joined = int(np.count_nonzero(held[ring.ends[0]] & held[ring.ends[1]]))
+    return int(np.count_nonzero(held)) - joined <= 1  # stretches of a closed path: cells - steps
+
+
+def _door_bounds(space: FreeSpace) -> tuple[int, int, int, int] | None:
+    """The first and last rows and columns of the room's door cells (None: it has none)."""
+    rings: dict[object, object] = kept(space, "rings", 4096)
+    if "door" not in rings:
+        rows, cols = np.nonzero(space.door)
+        rings["door"] = None if len(rows) == 0 else (int(rows.min()), int(rows.max()),
+                                                     int(cols.min()), int(cols.max()))
+    found: tuple[int, int, int, int] | None = rings["door"]  # type: ignore[assignment]
+    return found
 
 
 def _reach(space: FreeSpace, taken: BoolArray, passage: float) -> tuple[BoolArray, BoolArray]:
