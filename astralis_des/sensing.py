@@ -71,15 +71,17 @@ class GeometricSensor:
         # cheap tests first: can any corner of the box be in the frame, and would the box
         # show enough pixels if nothing hid it?
         every = np.arange(len(pts))
-        near, _ = in_frame(view, pts, headings, targets, size, every, every)
+        axes = view.axes(headings)  # once per look, the rows of each test picked from them
+        near, _ = in_frame(view, pts, headings, targets, size, every, every, axes)
         if len(near) == 0:
             return None
-        bound = predict_pixels(view, pts[near], headings[near], targets[near], size, None)
+        bound = predict_pixels(view, pts[near], headings[near], targets[near], size, None,
+                               pick(axes, near))
         near = near[bound >= BOUND_SHARE * view.min_pixels]  # coarser: a margin
         for start in range(0, len(near), CHUNK):
             idx = near[start:start + CHUNK]
             pixels = predict_pixels(view, pts[idx], headings[idx], targets[idx], size,
-                                    self._sight)
+                                    self._sight, pick(axes, idx))
             hits = np.flatnonzero(pixels >= view.min_pixels)
             if len(hits):
                 i, count = int(idx[hits[0]]), int(pixels[hits[0]])

@@ -7,6 +7,8 @@ width, stays reachable from the door. Items that do not fit are reported, never 
 
 from __future__ import annotations
 
+import bisect
+import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -19,7 +21,7 @@ from astralis_des.streams import stream
 from astralis_des.world.catalogue import Catalogue, agree, avatar_size, default_catalogue
 from astralis_des.world.freespace import BoolArray, FreeSpace, room_free_space
 from astralis_des.world.geometry import Box
-from astralis_des.world.grids import backs_onto_wall, summed, window
+from astralis_des.world.grids import summed, wall_windows, window
 from astralis_des.world.model import Room, World
 from astralis_des.world.placing import Occupancy
 
@@ -87,8 +89,9 @@ def place_room(world: World, room_id: str, messiness: float, rng: np.random.Gene
         placed.append(Placed(kind, room_id, center, (*spot.extent, size[2]), spot.yaw,
                              attributes))
 
+    area = space.area
     for kind, item in catalogue.items.present().items():
-        for _ in range(_count(messiness * item.per_10m2_at_full * space.area / 10)):
+        for _ in range(_count(messiness * item.per_10m2_at_full * area / 10)):
             size = rng.uniform(item.size_min, item.size_max)
             put(kind, (float(size[0]), float(size[1]), float(size[2])), item.against_wall,
                 item.clearance)
@@ -200,15 +203,14 @@ def place_in(space: FreeSpace, occupied: Occupancy, footprint: Sequence[float],
     if not candidates:
         where = "along a wall" if against_wall else "on the free floor"
         return f"no {w:.2f} x {d:.2f} m spot {where}"
-    sizes = np.array([len(c[1]) for c in candidates])
-    total = int(sizes.sum())
+    bounds = list(itertools.accumulate(len(c[1]) for c in candidates))
+    total = bounds[-1]
     tries = rng.choice(total, size=min(attempts, total), replace=False)
-    bounds = np.cumsum(sizes)
-    for pick in tries:
-        which = int(np.searchsorted(bounds, pick, side="right"))
+    for pick in tries.tolist():
+        which = bisect.bisect_right(bounds, pick)
         layout, corners, width = candidates[which]
-        offset = int(pick - (bounds[which - 1] if which else 0))
-        spot = layout.spot(space, np.divmod(corners[offset], width))
+        offset = pick - (bounds[which - 1] if which else 0)
+        spot = layout.spot(space, divmod(int(corners[offset]), width))
         if occupied.try_stamp(space, _footprint_box(spot), clearance, passage):
             return spot
     return "every spot tried cuts off free floor from the door"
@@ -258,13 +260,19 @@ def _candidates(space: FreeSpace, occupied: Occupancy, w: float, d: float, again
     allowed &= ~occupied.near_taken(math.ceil(clearance / space.cell - 1e-6))
     allowed_table = summed(allowed)
     found = []
+    nx, ny = space.shape
     for layout in _layouts(w, d, space.cell, against_wall, turn):
         kx, ky = layout.cells
+        if against_wall and kx <= nx and ky <= ny:  # only the windows along the wall
+            corners, (a, b, c, e) = wall_windows(space, layout.wall, kx, ky)
+            table = allowed_table.ravel()
+            corners = corners[table[a] - table[b] - table[c] + table[e] == kx * ky]
+            if len(corners):
+                found.append((layout, corners, ny - ky + 1))
+            continue
         fits = window(allowed_table, kx, ky) == kx * ky
         if fits.size == 0:
             continue
-        if against_wall:
-            fits &= backs_onto_wall(space, layout.wall, kx, ky)
         corners = np.flatnonzero(fits)  # in the order of np.argwhere, as flat indices
         if len(corners):
             found.append((layout, corners, fits.shape[1]))

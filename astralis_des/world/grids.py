@@ -141,3 +141,21 @@ def backs_onto_wall(space: FreeSpace, wall: int, kx: int, ky: int) -> BoolArray:
         kept_backs[key] = backs
     out: BoolArray = kept_backs[key]
     return out
+
+
+def wall_windows(space: FreeSpace, wall: int, kx: int,
+                 ky: int) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
+    """The corners :func:`backs_onto_wall` allows (flat indices into its grid, in order), and
+    where a summed-area table of the room's grid (raveled) holds the four corners of each one's
+    ``kx`` by ``ky`` window, in :func:`window`'s order: so that the windows along the wall are
+    counted alone, not every window of the grid (kept on the room's free space, as the backs)."""
+    kept_backs: dict[object, Any] = kept(space, "wall_backs", 4096)
+    key = ("windows", wall, kx, ky)
+    if key not in kept_backs:
+        rows, cols = np.nonzero(backs_onto_wall(space, wall, kx, ky))
+        width = space.shape[1] + 1  # the table's
+        base = rows * width + cols
+        corners = rows * (space.shape[1] - ky + 1) + cols
+        kept_backs[key] = (corners, (base + kx * width + ky, base + ky, base + kx * width, base))
+    found: tuple[np.ndarray, tuple[np.ndarray, ...]] = kept_backs[key]
+    return found
