@@ -18,17 +18,17 @@ What is kept, on what (``kept(owner, NAME)``):
 - on a world's **router**: ``routes`` (waypoints, by ends and kind, read-only) and
   ``places`` (the place of a point);
 - on a **voxel map**: ``occupied_points`` (its occupied cells' centres);
-- on a room's **free space**: ``empty_reach`` (where a robot reaches in the empty room),
-  ``wall_backs`` (where a footprint's back lies along a wall, by wall and footprint) and
-  ``rings`` (the cells round a footprint grown by half the passage, by its size; the door's
-  bounds);
+- on a room's **free space**: ``empty_reach`` (where a robot reaches in the empty room, by
+  passage; the bounds of its door cells) and ``wall_backs`` (where a footprint's back lies
+  along a wall, and the windows there, by wall and footprint).
 
 Elsewhere, once per process and by value (``functools``): the packaged clutter catalogue, the
 ROS 2 message types, a camera's swath by view and height, a catalogue without its furniture,
 a motion's course by path and speed parameters (with the sighting samples along it,
-``kernel.course``), a world's solids as Rerun chunks once recorded twice and a layout's
-blueprint encoded (``sinks.prepared``, ``sinks.blueprint``: not on the world, which a study
-pickles for its workers), and the built worlds themselves (by file content and the robot kinds
+``kernel.course``), the ring of cells round a footprint by its size (``world.placing``), a
+world's solids as Rerun chunks once recorded twice and a layout's blueprint encoded
+(``sinks.prepared``, ``sinks.blueprint``: not on the world, which a study pickles for its
+workers), and the built worlds themselves (by file content and the robot kinds
 registered).
 
 The registries (kinds, actions, strategies, planners, drivers, looks, event kinds) fill as
@@ -42,7 +42,7 @@ from typing import Any
 
 NAMES = frozenset({"voxel_map", "block_field", "free_space", "furnished", "coverage",
                    "floor_cells", "first_pass", "sky", "ducked", "occupied_points",
-                   "empty_reach", "wall_backs", "rings", "routes", "places"})
+                   "empty_reach", "wall_backs", "routes", "places"})
 
 
 def kept(owner: object, name: str, limit: int | None = None) -> dict[Any, Any]:

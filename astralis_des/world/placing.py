@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
-from scipy import ndimage
 
 from astralis_des.memo import kept
-from astralis_des.world.freespace import CROSS, BoolArray, FreeSpace, IntArray
+from astralis_des.world.freespace import BoolArray, FreeSpace, IntArray
 from astralis_des.world.geometry import Box
 from astralis_des.world.grids import (
     Cells,
@@ -135,15 +135,12 @@ class _Ring:
 
 
 def _ring(space: FreeSpace, kx: int, ky: int, radius: float) -> _Ring | None:
-    """The ring round a ``kx`` by ``ky`` rectangle grown by ``radius`` cells (kept on the room's
-    free space, by size), or None where its cells make no simple closed path."""
-    rings: dict[object, _Ring | None] = kept(space, "rings", 4096)
-    key = (kx, ky, radius)
-    if key not in rings:
-        rings[key] = _make_ring(kx, ky, radius, space.shape[1])
-    return rings[key]
+    """The ring round a ``kx`` by ``ky`` rectangle grown by ``radius`` cells on the room's
+    grid, or None where its cells make no simple closed path."""
+    return _make_ring(kx, ky, radius, space.shape[1])
 
 
+@lru_cache(maxsize=4096)
 def _make_ring(kx: int, ky: int, radius: float, width: int) -> _Ring | None:
     grow = math.floor(radius + 1e-9)
     o = grow + 2
@@ -151,19 +148,39 @@ def _make_ring(kx: int, ky: int, radius: float, width: int) -> _Ring | None:
     for di in range(grow + 1):  # as erode_without clears them
         h = math.floor(math.sqrt(radius * radius - di * di) + 1e-9)
         grown[o - di:o + kx + di, o - h:o + ky + h] = True
-    ring = ndimage.binary_dilation(grown, np.ones((3, 3), dtype=bool)) & ~grown
+    near = grown.copy()  # grown by a cell each way, corners too (a 3 x 3 dilation)
+    near[1:] |= grown[:-1]
+    near[:-1] |= grown[1:]
+    wide = near.copy()
+    wide[:, 1:] |= near[:, :-1]
+    wide[:, :-1] |= near[:, 1:]
+    ring = wide & ~grown
     index = np.full(ring.shape, -1)
     rows, cols = np.nonzero(ring)
     index[rows, cols] = np.arange(len(rows))
-    steps = [(index[:-1, :][ring[:-1, :] & ring[1:, :]], index[1:, :][ring[:-1, :] & ring[1:, :]]),
-             (index[:, :-1][ring[:, :-1] & ring[:, 1:]], index[:, 1:][ring[:, :-1] & ring[:, 1:]])]
-    first = np.concatenate([a for a, _ in steps])
-    second = np.concatenate([b for _, b in steps])
-    degree = np.bincount(np.concatenate([first, second]), minlength=len(rows))
-    if not (degree == 2).all() or ndimage.label(ring, CROSS)[1] != 1:
+    down, across = ring[:-1, :] & ring[1:, :], ring[:, :-1] & ring[:, 1:]
+    first = np.concatenate([index[:-1, :][down], index[:, :-1][across]])
+    second = np.concatenate([index[1:, :][down], index[:, 1:][across]])
+    if not _one_loop(first.tolist(), second.tolist(), len(rows)):
         return None
     rows, cols = rows - o, cols - o
     return _Ring(rows, cols, rows * width + cols, (first, second), grow)
+
+
+def _one_loop(first: list[int], second: list[int], cells: int) -> bool:
+    """Whether the steps join the cells into a single closed path (each cell in two steps,
+    and a walk along them from a cell meets every cell before it is back)."""
+    joined: list[list[int]] = [[] for _ in range(cells)]
+    for a, b in zip(first, second, strict=True):
+        joined[a].append(b)
+        joined[b].append(a)
+    if cells < 4 or any(len(j) != 2 for j in joined):
+        return False
+    before, here, walked = 0, joined[0][0], 1
+    while here != 0:
+        before, here = here, joined[here][0] if joined[here][0] != before else joined[here][1]
+        walked += 1
+    return walked == cells
 
 
 def _keeps_reach(space: FreeSpace, reach: BoolArray, radius: float, lost: Cells) -> bool:
@@ -198,12 +215,12 @@ def _keeps_reach(space: FreeSpace, reach: BoolArray, radius: float, lost: Cells)
 
 def _door_bounds(space: FreeSpace) -> tuple[int, int, int, int] | None:
     """The first and last rows and columns of the room's door cells (None: it has none)."""
-    rings: dict[object, object] = kept(space, "rings", 4096)
-    if "door" not in rings:
+    reach: dict[object, object] = kept(space, "empty_reach", 64)
+    if "door" not in reach:
         rows, cols = np.nonzero(space.door)
-        rings["door"] = None if len(rows) == 0 else (int(rows.min()), int(rows.max()),
+        reach["door"] = None if len(rows) == 0 else (int(rows.min()), int(rows.max()),
                                                      int(cols.min()), int(cols.max()))
-    found: tuple[int, int, int, int] | None = rings["door"]  # type: ignore[assignment]
+    found: tuple[int, int, int, int] | None = reach["door"]  # type: ignore[assignment]
     return found
 
 
