@@ -12,6 +12,7 @@ body clears, else by a route.
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -219,13 +220,24 @@ def _grid(ctx: Context, here: FloatArray, centre: FloatArray, floor: float,
 
 
 def _free_on(boxes: FloatArray, grid: _Grid, floor: float) -> np.ndarray:
-    """:func:`_free` of the grid's spots: a box meets a spot's square where it meets its
-    column (x) and its row (y), at the grid's height."""
+    """:func:`_free` of the grid's spots: the spots whose square a box meets are those of a
+    range of columns (x) and rows (y), at the grid's height; the ranges are counted on the
+    grid at once (a table of differences, summed)."""
     xs, ys = grid.xs, grid.ys
     boxes = boxes[(boxes[:, 0, 2] < grid.z) & (boxes[:, 1, 2] > floor + 0.02)]
-    cols = (boxes[:, 0, 0, None] < xs + LANDING_CLEAR) & (boxes[:, 1, 0, None] > xs - LANDING_CLEAR)
-    rows = (boxes[:, 0, 1, None] < ys + LANDING_CLEAR) & (boxes[:, 1, 1, None] > ys - LANDING_CLEAR)
-    free = ~((cols.T.astype(float) @ rows.astype(float)) > 0).ravel()
+    # the spots whose lo < a box's hi and whose hi > its lo, an axis at a time: the spots'
+    # bounds grow with their index, so these are the ranges searchsorted finds
+    i0 = np.searchsorted(xs + LANDING_CLEAR, boxes[:, 0, 0], side="right")
+    i1 = np.searchsorted(xs - LANDING_CLEAR, boxes[:, 1, 0], side="left")
+    j0 = np.searchsorted(ys + LANDING_CLEAR, boxes[:, 0, 1], side="right")
+    j1 = np.searchsorted(ys - LANDING_CLEAR, boxes[:, 1, 1], side="left")
+    some = (i0 < i1) & (j0 < j1)
+    i0, i1, j0, j1 = i0[some], i1[some], j0[some], j1[some]
+    counts = np.zeros((len(xs) + 1, len(ys) + 1), dtype=np.int64)
+    for rows, cols, step in ((i0, j0, 1), (i0, j1, -1), (i1, j0, -1), (i1, j1, 1)):
+        np.add.at(counts, (rows, cols), step)
+    hit = np.cumsum(np.cumsum(counts, axis=0), axis=1)[:-1, :-1] > 0
+    free = ~hit.ravel()
     return free if grid.where is None else free[grid.where]
 
 
@@ -270,7 +282,8 @@ def _first_clear(solid: FloatArray, here: FloatArray, spots: FloatArray,
 
 
 def _steps(here: FloatArray, spot: FloatArray) -> int:
-    return max(int(np.ceil(float(np.linalg.norm(spot - here)) / 0.1)), 1)
+    d = spot - here  # np.linalg.norm's sum for a vector, without its overhead
+    return max(math.ceil(math.sqrt(float(d.dot(d))) / 0.1), 1)
 
 
 def _along(loop: FloatArray, size: tuple[float, float, float]) -> FloatArray:
