@@ -193,9 +193,23 @@ class GeometricSensor:
                 seen[ci[in_room[pi]]] = True
             left = ~seen[ci]
             if left.any():
-                clear = self._sight(pts[pi[left]], cells[ci[left]], rooms)
-                seen[ci[left][clear]] = True
+                self._see(pts, cells, pi[left], ci[left], seen, rooms)
         return float(seen.mean())
+
+    def _see(self, pts: FloatArray, cells: FloatArray, pi: np.ndarray, ci: np.ndarray,
+             seen: np.ndarray, rooms: list[str] | None) -> None:
+        """Mark ``seen`` the cells of the pairs (point ``pi``, cell ``ci``) with a clear line
+        of sight: one pair a cell first (most are clear), then the other pairs of the cells
+        left (the same cells as every pair judged at once)."""
+        _, once = np.unique(ci, return_index=True)
+        clear = self._sight(pts[pi[once]], cells[ci[once]], rooms)
+        seen[ci[once][clear]] = True
+        rest = np.ones(len(ci), dtype=bool)
+        rest[once] = False
+        rest &= ~seen[ci]
+        if rest.any():
+            clear = self._sight(pts[pi[rest]], cells[ci[rest]], rooms)
+            seen[ci[rest][clear]] = True
 
     def _first_pass(self, view: View, pts: FloatArray, heads: FloatArray, axes: Axes,
                     full: FloatArray, size: FloatArray, room: Room) -> np.ndarray:

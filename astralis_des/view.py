@@ -100,7 +100,7 @@ class View:
         result: FloatArray = near & (z > 1e-6) & (x <= z * self.tan_h) & (y <= z * self.tan_v)
         return result
 
-    @property
+    @cached_property
     def reach(self) -> float:
         """How far the camera can detect the target at all: its range cap, else the distance
         at which a target seen square on shrinks to ``min_pixels``."""
