@@ -229,14 +229,15 @@ class HumanDriver(PlacedDriver):
 
 def ramp(current: FloatArray, target: FloatArray, step: float) -> FloatArray:
     """Move ``current`` towards ``target`` by at most ``step`` (plain floats: every tick)."""
-    dx, dy = float(target[0] - current[0]), float(target[1] - current[1])
+    (tx, ty), (cx, cy) = target.tolist(), current.tolist()
+    dx, dy = tx - cx, ty - cy
     if dx == 0.0 and dy == 0.0:
         return current
     norm = (dx * dx + dy * dy) ** 0.5
     if norm <= step:
-        return np.array([float(target[0]), float(target[1])])
+        return np.array([tx, ty])
     k = step / norm
-    return np.array([float(current[0]) + dx * k, float(current[1]) + dy * k])
+    return np.array([cx + dx * k, cy + dy * k])
 
 
 def samples_along(points: FloatArray, cum: FloatArray, start: float,

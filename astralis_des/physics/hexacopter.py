@@ -24,6 +24,7 @@ KP_POS = 1.2  # 1/s: position error -> velocity
 KV = 3.0  # 1/s: velocity error -> acceleration
 K_ATT = (7.0, 7.0, 2.0)  # 1/s: attitude error -> body rate
 K_RATE = (22.0, 22.0, 8.0)  # 1/s: rate error -> angular acceleration
+_NEG_K_ATT = tuple(-k for k in K_ATT)
 
 
 def write_urdf(spec: HexacopterSpec, folder: Path) -> Path:
@@ -74,9 +75,11 @@ class Hexacopter:
         self.max_speed = 3.0
         self.max_horizontal = min(spec.max_accel, GRAVITY * self.tilt)
         # plain floats (numpy's scalars cost ten times more each; the arithmetic is the same)
-        self._geometry = [(tuple(self.mix[i].tolist()),
-                           (float(self.rotors[i, 0]), float(self.rotors[i, 1])),
-                           float(self.spin[i])) for i in range(ROTORS)]
+        self._geometry = [(*self.mix[i].tolist(), float(self.rotors[i, 0]),
+                           float(self.rotors[i, 1]), float(self.spin[i])) for i in range(ROTORS)]
+        self._mass, self._inertia = spec.mass, tuple(spec.inertia)
+        self._kf, self._km = spec.thrust_constant, spec.moment_constant
+        self._rate_gains = tuple(j * k for j, k in zip(spec.inertia, K_RATE, strict=True))
         self.hover_speed = hover
         self.rotor_speed = [hover] * ROTORS
 
@@ -102,19 +105,21 @@ class Hexacopter:
         the craft is from ``p_ref`` (m).
 
         Written on plain floats: for 3-vectors, numpy's call overhead costs more than the
-        arithmetic (``np.cross`` alone takes 20 us).
+        arithmetic (``np.cross`` alone takes 20 us); the spec's numbers are read into locals
+        once (each UAV runs this every control period).
         """
-        spec, cid, body = self.spec, self.client.id, self.body
+        cid, body = self.client.id, self.body
         (px, py, pz), quat = pb.getBasePositionAndOrientation(body, physicsClientId=cid)
         (vx, vy, vz), (wx, wy, wz) = pb.getBaseVelocity(body, physicsClientId=cid)
         r00, r01, r02, r10, r11, r12, r20, r21, r22 = pb.getMatrixFromQuaternion(quat)
+        mass, (jx, jy, jz), max_speed = self._mass, self._inertia, self.max_speed
         # position -> velocity -> acceleration, with speed, tilt and climb limits
         dx = v_ref[0] + KP_POS * (p_ref[0] - px)
         dy = v_ref[1] + KP_POS * (p_ref[1] - py)
         dz = v_ref[2] + KP_POS * (p_ref[2] - pz)
         speed = math.sqrt(dx * dx + dy * dy + dz * dz)
-        if speed > self.max_speed:
-            k = self.max_speed / speed
+        if speed > max_speed:
+            k = max_speed / speed
             dx, dy, dz = dx * k, dy * k, dz * k
         # the reference's own acceleration, fed forward: without it a cascade of two
         # proportional loops lags a reference speeding up at a by a / (KP_POS * KV) metres
@@ -126,7 +131,7 @@ class Hexacopter:
             k = self.max_horizontal / horizontal
             ax, ay = ax * k, ay * k
         az = min(max(az, -0.5 * GRAVITY), 0.5 * GRAVITY)
-        fx, fy, fz = spec.mass * ax, spec.mass * ay, spec.mass * (az + GRAVITY)
+        fx, fy, fz = mass * ax, mass * ay, mass * (az + GRAVITY)
         thrust = max(fx * r02 + fy * r12 + fz * r22, 0.0)
         norm = math.sqrt(fx * fx + fy * fy + fz * fz)
         zx, zy, zz = fx / norm, fy / norm, fz / norm
@@ -144,32 +149,21 @@ class Hexacopter:
         bx = r00 * wx + r10 * wy + r20 * wz
         by = r01 * wx + r11 * wy + r21 * wz
         bz = r02 * wx + r12 * wy + r22 * wz
-        jx, jy, jz = spec.inertia
-        tx = jx * K_RATE[0] * (-K_ATT[0] * e0 - bx) + (by * jz * bz - bz * jy * by)
-        ty = jy * K_RATE[1] * (-K_ATT[1] * e1 - by) + (bz * jx * bx - bx * jz * bz)
-        tz = jz * K_RATE[2] * (-K_ATT[2] * e2 - bz) + (bx * jy * by - by * jx * bx)
-        self._rotors((thrust, tx, ty, tz), (px, py, pz),
-                     (r00, r01, r02, r10, r11, r12, r20, r21, r22))
-        ex, ey, ez = p_ref[0] - px, p_ref[1] - py, p_ref[2] - pz
-        return math.sqrt(ex * ex + ey * ey + ez * ez)
-
-    def _rotors(self, wrench: tuple[float, float, float, float], pos: Vec,
-                rot: tuple[float, ...]) -> None:
-        """Mix (thrust, torques) to rotor thrusts through the motors' lag; apply them.
-
-        Each rotor pushes along the body's z at its arm's end; applied as their sum at the
-        centre of mass and the sum of their moments about it plus the rotors' drag torque
-        (what PyBullet makes of a force at a point: two calls instead of seven)."""
-        kf, km = self.spec.thrust_constant, self.spec.moment_constant
-        r00, r01, r02, r10, r11, r12, r20, r21, r22 = rot
-        ux, uy, uz = r02, r12, r22
-        w0, w1, w2, w3 = wrench
-        ceiling, alpha, speeds, sqrt = self.max_thrust, self.motor_alpha, self.rotor_speed, \
-            math.sqrt
+        (gx, gy, gz), (ex_, ey_, ez_) = self._rate_gains, _NEG_K_ATT
+        w1 = gx * (ex_ * e0 - bx) + (by * jz * bz - bz * jy * by)
+        w2 = gy * (ey_ * e1 - by) + (bz * jx * bx - bx * jz * bz)
+        w3 = gz * (ez_ * e2 - bz) + (bx * jy * by - by * jx * bx)
+        # the rotors: mix (thrust, torques) to rotor thrusts through the motors' lag. Each
+        # pushes along the body's z at its arm's end; applied as their sum at the centre of
+        # mass and the sum of their moments about it plus the rotors' drag torque (what
+        # PyBullet makes of a force at a point: two calls instead of seven)
+        kf, ceiling, alpha, speeds = self._kf, self.max_thrust, self.motor_alpha, \
+            self.rotor_speed
+        sqrt = math.sqrt
         drag = total = 0.0
         mx = my = mz = 0.0  # sum of thrust x the arm's end, relative to the centre of mass
-        for i, ((m0, m1, m2, m3), (ox, oy), spin) in enumerate(self._geometry):
-            wanted = min(max(m0 * w0 + m1 * w1 + m2 * w2 + m3 * w3, 0.0), ceiling)
+        for i, (m0, m1, m2, m3, ox, oy, spin) in enumerate(self._geometry):
+            wanted = min(max(m0 * thrust + m1 * w1 + m2 * w2 + m3 * w3, 0.0), ceiling)
             speed = speeds[i]
             speed += (sqrt(wanted / kf) - speed) * alpha
             speeds[i] = speed
@@ -179,10 +173,11 @@ class Hexacopter:
             mx += f * (r00 * ox + r01 * oy)
             my += f * (r10 * ox + r11 * oy)
             mz += f * (r20 * ox + r21 * oy)
-        drag *= km
-        torque = (my * uz - mz * uy + ux * drag, mz * ux - mx * uz + uy * drag,
-                  mx * uy - my * ux + uz * drag)
-        cid, body = self.client.id, self.body
-        pb.applyExternalForce(body, -1, (ux * total, uy * total, uz * total), tuple(pos),
+        drag *= self._km
+        torque = (my * r22 - mz * r12 + r02 * drag, mz * r02 - mx * r22 + r12 * drag,
+                  mx * r12 - my * r02 + r22 * drag)
+        pb.applyExternalForce(body, -1, (r02 * total, r12 * total, r22 * total), (px, py, pz),
                               pb.WORLD_FRAME, physicsClientId=cid)
         pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, physicsClientId=cid)
+        ex, ey, ez = p_ref[0] - px, p_ref[1] - py, p_ref[2] - pz
+        return math.sqrt(ex * ex + ey * ey + ez * ez)

@@ -119,31 +119,39 @@ class LocalLayer:
         gaps = np.linalg.norm(movers[:, None, :] - moving[None, :, :], axis=2)
         self.near = [int(i) for i in np.flatnonzero((gaps < NEAR).any(axis=1))]
         by_name = {b.name: b for b in bodies}
+        seen = {rid: self._others(by_name[rid], bodies, where) for rid in self.cosim.active}
+        for rid, others in seen.items():
+            if not others:  # nothing in sight: nothing to avoid (the usual case, and cheap)
+                driver = self.cosim.drivers[rid]
+                driver.arrive_within = 0.2
+                driver.avoid(False, np.zeros(2))
+        if not any(seen.values()):  # no one's path ahead is asked for
+            return requests
         paths = {rid: self.cosim.drivers[rid].path_ahead(PATH_AHEAD) for rid in self.cosim.active}
         doors = _Doors(self, by_name, paths)
         self._paths = {rid: path[:, :2] + by_name[rid].offset for rid, path in paths.items()}
         for i in self.near:  # where the movers near a robot will walk: scripted, so known
             mover = self.cosim.movers[i][0]
             self._paths[mover.id] = mover.positions_at(t + MOVER_AHEAD)[:, :2]
-        for rid in self.cosim.active:
-            self._decide_for(rid, by_name[rid], bodies, where, paths[rid], doors, requests)
+        for rid, others in seen.items():
+            if others:
+                self._decide_for(rid, by_name[rid], others, paths[rid], doors, requests)
         return requests
 
-    def _decide_for(self, rid: str, me: Body, bodies: list[Body], where: FloatArray,
-                    ahead: FloatArray, doors: _Doors, requests: Requests) -> None:
+    def _others(self, me: Body, bodies: list[Body], where: FloatArray) -> list[Body]:
+        """The bodies near ``me`` (``where``: theirs), at heights it spans, in sight of it."""
+        near = np.linalg.norm(where - me.xy, axis=1) < PASS_RANGE + 1.0
+        low, high = me.base_z[0] - 0.3, max(me.z[1], me.base_z[1]) + 0.3
+        return self._in_sight(me, [b for b, c in zip(bodies, near, strict=True)
+                                   if c and b.name != me.name
+                                   and max(b.z[1], b.base_z[1]) >= low
+                                   and min(b.z[0], b.base_z[0]) <= high])
+
+    def _decide_for(self, rid: str, me: Body, others: list[Body], ahead: FloatArray,
+                    doors: _Doors, requests: Requests) -> None:
         driver = self.cosim.drivers[rid]
         direction = driver.heading_vector()
         speed = float(np.linalg.norm(direction))
-        near = np.linalg.norm(where - me.xy, axis=1) < PASS_RANGE + 1.0
-        low, high = me.base_z[0] - 0.3, max(me.z[1], me.base_z[1]) + 0.3
-        others = self._in_sight(me, [b for b, c in zip(bodies, near, strict=True)
-                                     if c and b.name != me.name
-                                     and max(b.z[1], b.base_z[1]) >= low
-                                     and min(b.z[0], b.base_z[0]) <= high])
-        if not others:  # nothing in sight: nothing to avoid (the usual case, and cheap)
-            driver.arrive_within = 0.2
-            driver.avoid(False, np.zeros(2))
-            return
         if speed < 1e-6:  # at its point: a UAV still rises over a walker coming at it
             here = me.xy[None, :]
             climb = self.climber.need(me, others, np.zeros(2), here, here,

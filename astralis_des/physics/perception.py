@@ -280,7 +280,9 @@ class Perception:
         last = self.cosim.t
         ticks = max(1, round(1.0 / (spec.rate * self.cosim.period)))
         while not done.triggered:
-            yield self.env.timeout(ticks * self.cosim.period) | done
+            # a plain timeout, not one or ``done``: a condition costs more than the reading,
+            # and a motion that ended meanwhile reads nothing either way
+            yield self.env.timeout(ticks * self.cosim.period)
             dt = self.cosim.t - last
             if dt <= 1e-9 or done.triggered:
                 continue

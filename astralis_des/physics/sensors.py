@@ -33,6 +33,7 @@ IntArray = NDArray[np.int32]
 NO_BODY = -1  # segmentation and hit id where nothing was seen
 # (u, v) of pixel (0, 0)'s centre: TinyRenderer's, measured; the ideal pinhole's is (0.5, 0.5)
 PIXEL_CENTRE = {pb.ER_TINY_RENDERER: (0.0, 1.0)}
+_DOWN = np.array([0.0, 0.0, -GRAVITY])  # gravity's acceleration: an IMU at rest reads its opposite
 
 
 def _body_pose(client: PhysicsClient, body: int) -> tuple[FloatArray, FloatArray]:
@@ -265,16 +266,22 @@ class Imu:
 
     def __post_init__(self) -> None:
         _need_rng(max(self.accel_std, self.gyro_std), self.rng, "Imu")
+        self._biases = (np.asarray(self.accel_bias, dtype=float),
+                        np.asarray(self.gyro_bias, dtype=float))
 
     def read(self, dt: float, time: float = 0.0) -> ImuReading:
         """A reading ``dt`` seconds after the previous one (the first assumes no acceleration)."""
-        _, rotation = _body_pose(self.client, self.body)
-        linear, angular = (np.array(v) for v in self.client.call("getBaseVelocity", self.body))
+        cid, body = self.client.id, self.body  # pybullet at first hand: read at 20 Hz a robot
+        quat = pb.getBasePositionAndOrientation(body, physicsClientId=cid)[1]
+        rotation = np.array(pb.getMatrixFromQuaternion(quat, physicsClientId=cid)).reshape(3, 3)
+        velocity = pb.getBaseVelocity(body, physicsClientId=cid)
+        linear, angular = np.array(velocity[0]), np.array(velocity[1])
         previous = linear if self._velocity is None else self._velocity
         self._velocity = linear
         accel = (linear - previous) / dt
-        force = rotation.T @ (accel - np.array([0.0, 0.0, -GRAVITY])) + self.accel_bias
-        rate = rotation.T @ angular + self.gyro_bias
+        accel_bias, gyro_bias = self._biases
+        force = rotation.T @ (accel - _DOWN) + accel_bias
+        rate = rotation.T @ angular + gyro_bias
         if self.rng is not None:
             force = force + self.rng.normal(0.0, self.accel_std, 3)
             rate = rate + self.rng.normal(0.0, self.gyro_std, 3)
