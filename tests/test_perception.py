@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from astralis_des import Simulation, load_mission
+from astralis_des.kernel.robot import Motion
 from astralis_des.mission.spec import CameraSpec, LidarSpec
 from astralis_des.physics.perception import CREEP, SLOW_AT, STOP_AT
 
@@ -98,17 +99,37 @@ def test_the_lidar_slows_the_ugv_for_what_is_ahead() -> None:
     sim = sim_with(UGV, target=[70.0, 86.0, 0.5])
     driver = sim.cosim.drivers["ugv1"]
     perception = sim.cosim.perception
-    done = sim.env.event()
-    next(perception._scan(sim.robots["ugv1"], done))
+    done, robot = sim.env.event(), sim.robots["ugv1"]
+    next(perception._scan(robot, done, robot.motion))
     assert driver.husky.limit == math.inf
     sim.cosim.client.add_box((69.9, 83.0, 0.5), (0.2, 1.0, 1.0))
-    next(perception._scan(sim.robots["ugv1"], done))
+    next(perception._scan(robot, done, robot.motion))
     points, here = perception.scans[-1].points, driver.position()
     ahead = points[(np.abs(points[:, 1] - here[1]) < 0.3) & (points[:, 0] > here[0])]
     nearest = float(np.min(ahead[:, 0])) - here[0]
     assert nearest == pytest.approx(1.0, abs=0.05)
     share = max((nearest - STOP_AT) / (SLOW_AT - STOP_AT), CREEP)
     assert driver.husky.limit == pytest.approx(share * driver.speed, abs=0.03)
+    sim.finish()
+
+
+def test_a_halted_motion_stops_its_lidar_and_imu() -> None:
+    """A motion halted midway (a fault, a new order) ends its lidar and IMU with it: the UGV
+    standing there is not scanned at 10 Hz or read at 20 Hz for the rest of the run, and its
+    speed cap is lifted (the event of a halted motion never fires)."""
+    sim = sim_with(UGV, target=[70.0, 86.0, 0.5])
+    robot, perception = sim.robots["ugv1"], sim.cosim.perception
+    driver = sim.cosim.drivers["ugv1"]
+    sim.cosim.execute(robot, Motion(np.array([robot.pose, (71.0, 83.0, 0.0)]), robot.speed,
+                                    accel=robot.accel))
+    sim.env.run(until=sim.env.now + 1.5)
+    scans, readings = perception.clock.calls["lidar"], perception.clock.calls["imu"]
+    assert scans >= 10 and readings >= 20  # 10 Hz and 20 Hz while it moved
+    sim.cosim.halt(robot)
+    sim.env.run(until=sim.env.now + 3.0)
+    assert perception.clock.calls["lidar"] == scans
+    assert perception.clock.calls["imu"] == readings
+    assert driver.husky.limit == math.inf
     sim.finish()
 
 

@@ -226,20 +226,29 @@ class Perception:
 
     # -- lidars and IMUs ---------------------------------------------------------------------
     def moving(self, robot: Robot, done: simpy.Event) -> None:
-        """Start the robot's lidar and IMU for a motion that ends with ``done``."""
+        """Start the robot's lidar and IMU for a motion that ends with ``done``, or stops
+        being the robot's motion (halted for a fault, or a new one in its place: ``done``
+        of a halted motion never fires)."""
+        track = robot.motion
         if robot.id in self.lidars:
-            self.env.process(self._scan(robot, done))
+            self.env.process(self._scan(robot, done, track))
         if robot.id in self.imus:
-            self.env.process(self._read(robot, done))
+            self.env.process(self._read(robot, done, track))
         if robot.id in self.lidars3d:
-            self.env.process(self._sweep(robot, done))
+            self.env.process(self._sweep(robot, done, track))
 
-    def _sweep(self, robot: Robot, done: simpy.Event) -> Generator[simpy.Event, Any, None]:
+    @staticmethod
+    def _on(robot: Robot, done: simpy.Event, track: object) -> bool:
+        """Is the motion ``track`` (ending with ``done``) still going?"""
+        return not done.triggered and robot.motion is track
+
+    def _sweep(self, robot: Robot, done: simpy.Event,
+               track: object) -> Generator[simpy.Event, Any, None]:
         """The 3-D lidar at its rate while the robot moves; every so often a sweep kept."""
         lidar, spec = self.lidars3d[robot.id]
         keep_every = max(1, round(spec.rate / spec.record_rate)) if spec.record_rate else 0
         count = 0
-        while not done.triggered:
+        while self._on(robot, done, track):
             with self.clock.timed("lidar3d"):
                 scan = lidar.scan(self.env.now)
             if keep_every and count % keep_every == 0:
@@ -249,12 +258,13 @@ class Perception:
             count += 1
             yield self.env.timeout(1.0 / spec.rate) | done
 
-    def _scan(self, robot: Robot, done: simpy.Event) -> Generator[simpy.Event, Any, None]:
+    def _scan(self, robot: Robot, done: simpy.Event,
+              track: object) -> Generator[simpy.Event, Any, None]:
         lidar, spec = self.lidars[robot.id]
         driver = self.cosim.drivers[robot.id]
         keep_every = max(1, round(spec.rate / spec.record_rate)) if spec.record_rate else 0
         count = 0
-        while not done.triggered:
+        while self._on(robot, done, track):
             with self.clock.timed("lidar"):
                 scan = lidar.scan(self.env.now)
                 # the sector it slows down for looks the way it is headed (to its pursued
@@ -271,20 +281,22 @@ class Perception:
                 self.scans.append(KeptScan(robot.id, self.env.now, hits))
             count += 1
             yield self.env.timeout(1.0 / spec.rate) | done
-        driver.slow_down(1.0)
+        if done.triggered or robot.motion is None:  # not a new motion's, which scans itself
+            driver.slow_down(1.0)
 
-    def _read(self, robot: Robot, done: simpy.Event) -> Generator[simpy.Event, Any, None]:
+    def _read(self, robot: Robot, done: simpy.Event,
+              track: object) -> Generator[simpy.Event, Any, None]:
         imu, spec = self.imus[robot.id]
         trace = self.imu_traces[robot.id]
         imu._velocity = None  # a new motion: no difference across the pause before it
         last = self.cosim.t
         ticks = max(1, round(1.0 / (spec.rate * self.cosim.period)))
-        while not done.triggered:
+        while self._on(robot, done, track):
             # a plain timeout, not one or ``done``: a condition costs more than the reading,
             # and a motion that ended meanwhile reads nothing either way
             yield self.env.timeout(ticks * self.cosim.period)
             dt = self.cosim.t - last
-            if dt <= 1e-9 or done.triggered:
+            if dt <= 1e-9 or not self._on(robot, done, track):
                 continue
             last = self.cosim.t
             with self.clock.timed("imu"):
