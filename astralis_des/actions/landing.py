@@ -62,15 +62,9 @@ def landing_way(ctx: Context, robot: Robot) -> FloatArray:
         if _in(ctx, spot, floor, room) and bool(scene.line_of_sight(here, spot)[0]) \
                 and _clears(solid, here, spot):
             return np.vstack([here, spot])
-    searches = [_grid(ctx, here, here, floor, room)]
-    if room is not None:  # none in its room: out of its door, to the corridor
-        door = np.array([*room.door.center[:2], here[2]])
-        searches.append(_grid(ctx, here, door, floor, None))
-    else:  # none near (over the stair hall's well): farther
-        searches.append(_grid(ctx, here, here, floor, None, 2 * LANDING_FAR))
-    for spots in searches:
-        spots = spots[_free(taken, spots, floor) &
-                      ~ctx.world.near_doorway(spots, floor, DOOR_KEEP)]
+    for centre, around, far in _searched(here, room):
+        spots = _grid(ctx, taken, here, centre, floor, around, far)
+        spots = spots[~ctx.world.near_doorway(spots, floor, DOOR_KEEP)]
         spots = spots[_supported(ctx, spots, floor)]
         way = _nearest_way(ctx, robot, here, spots, solid)
         if way is not None:
@@ -173,10 +167,21 @@ def _in(ctx: Context, spot: FloatArray, floor: float, room: Room | None) -> bool
     return (there.id if there else None) == (room.id if room else None)
 
 
-def _grid(ctx: Context, here: FloatArray, centre: FloatArray, floor: float,
-          room: Room | None, far: float = LANDING_FAR) -> FloatArray:
-    """Spots ``LANDING_GRID`` apart at ``here``'s height: over the room, else within
-    ``far`` of ``centre``, outside every room and over the same floor."""
+def _searched(here: FloatArray, room: Room | None
+              ) -> list[tuple[FloatArray, Room | None, float]]:
+    """Where the finer search looks, in turn: over the UAV's room, then round its door (the
+    corridor); outside any room, near it and then farther (over the stair hall's well)."""
+    if room is None:
+        return [(here, None, LANDING_FAR), (here, None, 2 * LANDING_FAR)]
+    door = np.array([*room.door.center[:2], here[2]])
+    return [(here, room, LANDING_FAR), (door, None, LANDING_FAR)]
+
+
+def _grid(ctx: Context, taken: FloatArray, here: FloatArray, centre: FloatArray,
+          floor: float, room: Room | None, far: float) -> FloatArray:
+    """The spots ``LANDING_GRID`` apart at ``here``'s height whose square is free of
+    ``taken`` (:func:`_free`): over the room, else within ``far`` of ``centre``, outside
+    every room and over the same floor."""
     if room is not None:
         lo = np.asarray(room.box.lo[:2], dtype=float) + LANDING_CLEAR
         hi = np.asarray(room.box.hi[:2], dtype=float) - LANDING_CLEAR
@@ -186,6 +191,7 @@ def _grid(ctx: Context, here: FloatArray, centre: FloatArray, floor: float,
     ys = np.arange(lo[1], hi[1] + 1e-9, LANDING_GRID)
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
     spots = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, here[2])])
+    spots = spots[_free_grid(taken, xs, ys, float(here[2]), floor)]
     if room is not None:
         return spots
     boxes = ctx.world.room_boxes
@@ -196,6 +202,27 @@ def _grid(ctx: Context, here: FloatArray, centre: FloatArray, floor: float,
     spots = spots[~inside]
     same = np.abs(ctx.world.floors_below(spots) - floor) < 0.05
     return spots[same] if len(spots) else spots
+
+
+def _free_grid(boxes: FloatArray, xs: FloatArray, ys: FloatArray, z: float,
+               floor: float) -> np.ndarray:
+    """:func:`_free` of the spots of the grid ``xs`` by ``ys`` (``ij`` order, raveled) at
+    height ``z``: the same comparisons, each box marking the block of spots it meets, found
+    by bisecting the grid's sorted coordinates."""
+    boxes = boxes[(boxes[:, 0, 2] < z) & (boxes[:, 1, 2] > floor + 0.02)]
+    x0 = np.searchsorted(xs + LANDING_CLEAR, boxes[:, 0, 0], side="right")
+    x1 = np.searchsorted(xs - LANDING_CLEAR, boxes[:, 1, 0], side="left")
+    y0 = np.searchsorted(ys + LANDING_CLEAR, boxes[:, 0, 1], side="right")
+    y1 = np.searchsorted(ys - LANDING_CLEAR, boxes[:, 1, 1], side="left")
+    some = (x0 < x1) & (y0 < y1)
+    x0, x1, y0, y1 = x0[some], x1[some], y0[some], y1[some]
+    marks = np.zeros((len(xs) + 1, len(ys) + 1), dtype=np.int64)  # corners of each block,
+    np.add.at(marks, (x0, y0), 1)  # summed over both axes: how many blocks cover a spot
+    np.add.at(marks, (x0, y1), -1)
+    np.add.at(marks, (x1, y0), -1)
+    np.add.at(marks, (x1, y1), 1)
+    covered = marks.cumsum(axis=0).cumsum(axis=1)[:len(xs), :len(ys)]
+    return (covered == 0).ravel()
 
 
 def _clears(solid: FloatArray, here: FloatArray, spot: FloatArray) -> bool:
