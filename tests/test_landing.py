@@ -10,8 +10,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from astralis_des.actions.landing import (DOOR_KEEP, LANDING_CLEAR, LANDING_GRID, _free,
-                                          _free_grid, landing_way)
+from astralis_des.actions.landing import (
+    DOOR_KEEP,
+    LANDING_CLEAR,
+    LANDING_GRID,
+    _free,
+    _free_grid,
+    landing_way,
+)
 from astralis_des.simulation import Simulation
 from astralis_des.studies import load_study
 from astralis_des.studies.eval_mission import scenario_mission
