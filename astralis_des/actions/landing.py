@@ -74,14 +74,21 @@ def landing_way(ctx: Context, robot: Robot) -> FloatArray:
     return here[None, :]
 
 
-def _rings(here: FloatArray) -> FloatArray:
-    """The spots on ``LANDING_RINGS`` around ``here``, nearest ring first (``here`` first)."""
-    spots = []
+def _ring_offsets() -> FloatArray:
+    """``(49, 3)``: the spots on ``LANDING_RINGS`` around the origin, nearest ring first."""
+    offsets = []
     for reach in LANDING_RINGS:
         angles = np.linspace(0.0, 2 * np.pi, 1 if reach == 0 else 12, endpoint=False)
-        spots += [here + reach * np.array([np.cos(angle), np.sin(angle), 0.0])
-                  for angle in angles]
-    return np.array(spots)
+        offsets += [reach * np.array([np.cos(angle), np.sin(angle), 0.0]) for angle in angles]
+    return np.array(offsets)
+
+
+RING_OFFSETS = _ring_offsets()
+
+
+def _rings(here: FloatArray) -> FloatArray:
+    """The spots on ``LANDING_RINGS`` around ``here``, nearest ring first (``here`` first)."""
+    return here + RING_OFFSETS
 
 
 def _nearest_way(ctx: Context, robot: Robot, here: FloatArray, spots: FloatArray,
