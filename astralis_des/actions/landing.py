@@ -251,7 +251,7 @@ def _first_clear(solid: FloatArray, here: FloatArray, spots: FloatArray,
     time), or None."""
     for start in range(0, len(spots), block):
         part = spots[start:start + block]
-        steps = np.array([_steps(here, spot) for spot in part])
+        steps = _steps_of(here, part)
         # each spot's points, as np.linspace(0, 1, steps + 1) places them
         which = np.repeat(np.arange(len(part)), steps + 1)
         first = np.concatenate([[0], np.cumsum(steps + 1)[:-1]])
@@ -274,6 +274,16 @@ def _first_clear(solid: FloatArray, here: FloatArray, spots: FloatArray,
 
 def _steps(here: FloatArray, spot: FloatArray) -> int:
     return max(int(np.ceil(float(np.linalg.norm(spot - here)) / 0.1)), 1)
+
+
+def _steps_of(here: FloatArray, spots: FloatArray) -> np.ndarray:
+    """:func:`_steps` of each of ``spots``: at once, and one at a time where a distance is so
+    near a whole number of steps that the rounding of the norm could change the count."""
+    tenths = np.sqrt(((spots - here) ** 2).sum(axis=1)) / 0.1
+    steps = np.maximum(np.ceil(tenths), 1).astype(np.intp)
+    for k in np.flatnonzero(np.abs(tenths - np.round(tenths)) < 1e-6):
+        steps[k] = _steps(here, spots[k])
+    return steps
 
 
 def _along(loop: FloatArray, size: tuple[float, float, float]) -> FloatArray:
