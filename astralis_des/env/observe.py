@@ -114,9 +114,9 @@ class Observer:
                              (2, run.inflight)):  # the last one a room is in counts
             states[[index[r] for r in these if r in index]] = state
         out[self._rows, states] = 1.0
-        out[:, 5] = [run.coverage.get(rid, 0.0) for rid in rooms]
-        out[:, 6] = [sim.rooms[rid].risk for rid in rooms]
-        out[:, 7] = [sim.rooms[rid].messiness for rid in rooms]
+        coverage, state = run.coverage, sim.rooms
+        out[:, 5:8] = [(coverage.get(rid, 0.0), state[rid].risk, state[rid].messiness)
+                       for rid in rooms]
         return out
 
     def observe(self, agent: str) -> dict[str, Any]:
