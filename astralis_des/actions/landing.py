@@ -12,6 +12,7 @@ body clears, else by a route.
 from __future__ import annotations
 
 import logging
+from typing import Any
 
 import numpy as np
 
@@ -123,7 +124,8 @@ def _taken(ctx: Context, robot: Robot, here: FloatArray, rooms: list[str]) -> Fl
         boxes = np.concatenate([boxes, np.array([[np.subtract(target.start, half),
                                                   np.add(target.start, half)]])])
     if walks:  # nor on the loop a walker or an obstacle goes round
-        boxes = np.concatenate([boxes, *[_along(m.loop, m.size) for m in walks]])
+        kept = ctx.world.memo("walk_boxes", 1024)  # the same loops at every landing
+        boxes = np.concatenate([boxes, *[_walked(kept, m.loop, m.size) for m in walks]])
     others = [r.position(ctx.env.now) for r in ctx.robots.values() if r is not robot]
     if others:
         at = np.array(others)
@@ -284,6 +286,16 @@ def _steps_of(here: FloatArray, spots: FloatArray) -> np.ndarray:
     for k in np.flatnonzero(np.abs(tenths - np.round(tenths)) < 1e-6):
         steps[k] = _steps(here, spots[k])
     return steps
+
+
+def _walked(kept: dict[Any, FloatArray], loop: FloatArray,
+            size: tuple[float, float, float]) -> FloatArray:
+    """:func:`_along`, ``kept`` by loop and size (read-only)."""
+    key = (loop.tobytes(), loop.shape, tuple(size))
+    if key not in kept:
+        kept[key] = _along(loop, size)
+        kept[key].flags.writeable = False
+    return kept[key]
 
 
 def _along(loop: FloatArray, size: tuple[float, float, float]) -> FloatArray:

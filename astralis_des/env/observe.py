@@ -114,8 +114,8 @@ class Observer:
                              (2, run.inflight)):  # the last one a room is in counts
             states[[index[r] for r in these if r in index]] = state
         out[self._rows, states] = 1.0
-        coverage, state = run.coverage, sim.rooms
-        out[:, 5:8] = [(coverage.get(rid, 0.0), state[rid].risk, state[rid].messiness)
+        coverage, now = run.coverage, sim.rooms
+        out[:, 5:8] = [(coverage.get(rid, 0.0), now[rid].risk, now[rid].messiness)
                        for rid in rooms]
         return out
 
