@@ -108,15 +108,23 @@ class Observer:
     def _rooms(self) -> np.ndarray:
         run, sim = self.run, self.run.sim
         out = self._static.copy()
-        index, rooms = run.layout.room_index, run.layout.rooms
-        states = np.zeros(len(rooms), dtype=np.intp)  # waiting for its segment
-        for state, these in ((1, run.pending), (4, run.given_up), (3, sim.searched),
-                             (2, run.inflight)):  # the last one a room is in counts
-            states[[index[r] for r in these if r in index]] = state
+        pending, searched = set(run.pending), set(sim.searched)
+        states, coverage, risk, messiness = [], [], [], []
+        for rid in run.layout.rooms:
+            if rid in run.inflight:
+                states.append(2)
+            elif rid in searched:
+                states.append(3)
+            elif rid in run.given_up:
+                states.append(4)
+            else:  # open now (the segment's), or waiting for its segment
+                states.append(1 if rid in pending else 0)
+            coverage.append(run.coverage.get(rid, 0.0))
+            state = sim.rooms[rid]
+            risk.append(state.risk)
+            messiness.append(state.messiness)
         out[self._rows, states] = 1.0
-        coverage, now = run.coverage, sim.rooms
-        out[:, 5:8] = [(coverage.get(rid, 0.0), now[rid].risk, now[rid].messiness)
-                       for rid in rooms]
+        out[:, 5], out[:, 6], out[:, 7] = coverage, risk, messiness
         return out
 
     def observe(self, agent: str) -> dict[str, Any]:
