@@ -13,7 +13,8 @@ What is kept, on what (``kept(owner, NAME)``):
   room's free floor, by cell size), ``furnished`` (a room's furniture, by its draw),
   ``coverage`` and ``first_pass`` (how much of a room a sweep sees), ``floor_cells`` (a
   room's coverage cells, and whether they lie in it alone), ``sky`` (the GNSS's open
-  sky), ``ducked`` (legs that duck under a lintel), and its router's Dijkstra rows
+  sky), ``ducked`` (legs that duck under a lintel), ``walk_boxes`` (the boxes along a
+  walker's loop a landing UAV keeps off, by loop and size), and its router's Dijkstra rows
   (``world.routing``, its own cache, at most 256 MB);
 - on a world's **router**: ``routes`` (waypoints, by ends and kind, read-only) and
   ``places`` (the place of a point);
@@ -41,8 +42,8 @@ from __future__ import annotations
 from typing import Any
 
 NAMES = frozenset({"voxel_map", "block_field", "free_space", "furnished", "coverage",
-                   "floor_cells", "first_pass", "sky", "ducked", "occupied_points",
-                   "empty_reach", "wall_backs", "routes", "places"})
+                   "floor_cells", "first_pass", "sky", "ducked", "walk_boxes",
+                   "occupied_points", "empty_reach", "wall_backs", "routes", "places"})
 
 
 def kept(owner: object, name: str, limit: int | None = None) -> dict[Any, Any]:

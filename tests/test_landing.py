@@ -10,7 +10,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from astralis_des.actions.landing import DOOR_KEEP, LANDING_CLEAR, landing_way
+from astralis_des.actions.landing import (
+    DOOR_KEEP,
+    LANDING_CLEAR,
+    LANDING_GRID,
+    _free,
+    _free_on,
+    _Grid,
+    landing_way,
+)
 from astralis_des.simulation import Simulation
 from astralis_des.studies import load_study
 from astralis_des.studies.eval_mission import scenario_mission
@@ -119,3 +127,21 @@ def test_a_uav_over_the_stairwell_lands_on_a_floor_not_down_the_well() -> None:
         assert np.any(np.all((at >= tops[:, 0, :2]) & (at <= tops[:, 1, :2]), axis=1))
     assert not np.any(np.all((np.array([62.0, 82.0]) >= tops[:, 0, :2]) &
                              (np.array([62.0, 82.0]) <= tops[:, 1, :2]), axis=1))  # the well
+
+
+def test_the_finer_search_marks_the_same_free_spots_as_the_spot_by_spot_test() -> None:
+    """A grid's free spots, found box by box, are those the spot by spot test finds (boxes
+    at exactly the clearance's distance from a spot included)."""
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        xs = np.arange(1.0, 1.0 + rng.uniform(0.0, 6.0) + 1e-9, LANDING_GRID)
+        ys = np.arange(2.0, 2.0 + rng.uniform(0.0, 6.0) + 1e-9, LANDING_GRID)
+        lo = rng.uniform(0.0, 9.0, (200, 3))
+        lo[:60, 0] = rng.choice(xs, 60) + LANDING_CLEAR  # touching a spot's square
+        hi = lo + rng.uniform(0.0, 2.0, (200, 3))
+        hi[60:120, 1] = rng.choice(ys, 60) - LANDING_CLEAR
+        gx, gy = np.meshgrid(xs, ys, indexing="ij")
+        spots = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, 1.5)])
+        boxes = np.stack([lo, hi], axis=1)
+        free = _free_on(boxes, _Grid(xs, ys, 1.5, None), 0.0)
+        assert np.array_equal(free, _free(boxes, spots, 0.0))

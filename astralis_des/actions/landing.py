@@ -14,6 +14,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -64,13 +65,8 @@ def landing_way(ctx: Context, robot: Robot) -> FloatArray:
         if _in(ctx, spot, floor, room) and bool(scene.line_of_sight(here, spot)[0]) \
                 and _clears(solid, here, spot):
             return np.vstack([here, spot])
-    searches = [_grid(ctx, here, here, floor, room)]
-    if room is not None:  # none in its room: out of its door, to the corridor
-        door = np.array([*room.door.center[:2], here[2]])
-        searches.append(_grid(ctx, here, door, floor, None))
-    else:  # none near (over the stair hall's well): farther
-        searches.append(_grid(ctx, here, here, floor, None, 2 * LANDING_FAR))
-    for grid in searches:
+    for centre, around, far in _searched(here, room):  # the corridor's grid only if needed
+        grid = _grid(ctx, here, centre, floor, around, far)
         spots = grid.spots[_free_on(taken, grid, floor)]
         spots = spots[~ctx.world.near_doorway(spots, floor, DOOR_KEEP)]
         spots = spots[_supported(ctx, spots, floor)]
@@ -82,14 +78,21 @@ def landing_way(ctx: Context, robot: Robot) -> FloatArray:
     return here[None, :]
 
 
-def _rings(here: FloatArray) -> FloatArray:
-    """The spots on ``LANDING_RINGS`` around ``here``, nearest ring first (``here`` first)."""
-    spots = []
+def _ring_offsets() -> FloatArray:
+    """``(49, 3)``: the spots on ``LANDING_RINGS`` around the origin, nearest ring first."""
+    offsets = []
     for reach in LANDING_RINGS:
         angles = np.linspace(0.0, 2 * np.pi, 1 if reach == 0 else 12, endpoint=False)
-        spots += [here + reach * np.array([np.cos(angle), np.sin(angle), 0.0])
-                  for angle in angles]
-    return np.array(spots)
+        offsets += [reach * np.array([np.cos(angle), np.sin(angle), 0.0]) for angle in angles]
+    return np.array(offsets)
+
+
+RING_OFFSETS = _ring_offsets()
+
+
+def _rings(here: FloatArray) -> FloatArray:
+    """The spots on ``LANDING_RINGS`` around ``here``, nearest ring first (``here`` first)."""
+    return here + RING_OFFSETS
 
 
 def _nearest_way(ctx: Context, robot: Robot, here: FloatArray, spots: FloatArray,
@@ -124,7 +127,8 @@ def _taken(ctx: Context, robot: Robot, here: FloatArray, rooms: list[str]) -> Fl
         boxes = np.concatenate([boxes, np.array([[np.subtract(target.start, half),
                                                   np.add(target.start, half)]])])
     if walks:  # nor on the loop a walker or an obstacle goes round
-        boxes = np.concatenate([boxes, *[_along(m.loop, m.size) for m in walks]])
+        kept = ctx.world.memo("walk_boxes", 1024)  # the same loops at every landing
+        boxes = np.concatenate([boxes, *[_walked(kept, m.loop, m.size) for m in walks]])
     others = [r.position(ctx.env.now) for r in ctx.robots.values() if r is not robot]
     if others:
         at = np.array(others)
@@ -173,6 +177,16 @@ def _in(ctx: Context, spot: FloatArray, floor: float, room: Room | None) -> bool
         return False
     there = ctx.world.room_at((spot[0], spot[1], floor + 0.5))
     return (there.id if there else None) == (room.id if room else None)
+
+
+def _searched(here: FloatArray, room: Room | None
+              ) -> list[tuple[FloatArray, Room | None, float]]:
+    """Where the finer search looks, in turn: over the UAV's room, then round its door (the
+    corridor); outside any room, near it and then farther (over the stair hall's well)."""
+    if room is None:
+        return [(here, None, LANDING_FAR), (here, None, 2 * LANDING_FAR)]
+    door = np.array([*room.door.center[:2], here[2]])
+    return [(here, room, LANDING_FAR), (door, None, LANDING_FAR)]
 
 
 @dataclass(frozen=True)
@@ -260,7 +274,7 @@ def _first_clear(solid: FloatArray, here: FloatArray, spots: FloatArray,
     time), or None."""
     for start in range(0, len(spots), block):
         part = spots[start:start + block]
-        steps = np.array([_steps(here, spot) for spot in part])
+        steps = _steps_of(here, part)
         # each spot's points, as np.linspace(0, 1, steps + 1) places them
         which = np.repeat(np.arange(len(part)), steps + 1)
         first = np.concatenate([[0], np.cumsum(steps + 1)[:-1]])
@@ -284,6 +298,26 @@ def _first_clear(solid: FloatArray, here: FloatArray, spots: FloatArray,
 def _steps(here: FloatArray, spot: FloatArray) -> int:
     d = spot - here  # np.linalg.norm's sum for a vector, without its overhead
     return max(math.ceil(math.sqrt(float(d.dot(d))) / 0.1), 1)
+
+
+def _steps_of(here: FloatArray, spots: FloatArray) -> np.ndarray:
+    """:func:`_steps` of each of ``spots``: at once, and one at a time where a distance is so
+    near a whole number of steps that the rounding of the norm could change the count."""
+    tenths = np.sqrt(((spots - here) ** 2).sum(axis=1)) / 0.1
+    steps = np.maximum(np.ceil(tenths), 1).astype(np.intp)
+    for k in np.flatnonzero(np.abs(tenths - np.round(tenths)) < 1e-6):
+        steps[k] = _steps(here, spots[k])
+    return steps
+
+
+def _walked(kept: dict[Any, FloatArray], loop: FloatArray,
+            size: tuple[float, float, float]) -> FloatArray:
+    """:func:`_along`, ``kept`` by loop and size (read-only)."""
+    key = (loop.tobytes(), loop.shape, tuple(size))
+    if key not in kept:
+        kept[key] = _along(loop, size)
+        kept[key].flags.writeable = False
+    return kept[key]
 
 
 def _along(loop: FloatArray, size: tuple[float, float, float]) -> FloatArray:

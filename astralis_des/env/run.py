@@ -162,8 +162,8 @@ class EpisodeRun:
         ``offered`` rooms."""
         self.asked, self.offered, self.choices = [r.id for r in free], offered, {}
         self._asking += 1
-        self.allowed = {r.id: {room for room, ok in zip(offered, allowed[i], strict=True) if ok}
-                        for i, r in enumerate(free)}
+        self.allowed = {r.id: {room for room, ok in zip(offered, row, strict=True) if ok}
+                        for r, row in zip(free, allowed.tolist(), strict=True)}
 
     def _commit(self) -> None:
         """The answers of this decision time: one round for the rooms taken, then holds."""

@@ -12,6 +12,7 @@ import simpy
 from astralis_des.kernel.catalogue import EVENTS
 
 Record = dict[str, Any]
+AS_IS = frozenset({str, int, bool})  # types plain() returns as they are
 Sink = Callable[[Record], None]
 
 
@@ -51,6 +52,8 @@ class EventLog:
 
 def plain(value: Any) -> Any:
     """JSON-ready, deterministic: numpy to Python, floats rounded to the micrometre/microsecond."""
+    if value is None or type(value) in AS_IS:  # most values (ids, names, counts) first
+        return value
     if isinstance(value, np.ndarray):
         return plain(value.tolist())
     if isinstance(value, np.generic):
