@@ -1,0 +1,98 @@
+"""The assignment rounds of a run: who is matched to which rooms, from where they stand, and
+the record each round leaves (``rounds`` in the summary, an ``assignment`` event)."""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import simpy
+
+from astralis_des.assignment import Agent, Assignment, RoomInfo, Weights, assign
+from astralis_des.kernel.events import EventLog
+from astralis_des.kernel.robot import Robot
+from astralis_des.streams import stream
+
+if TYPE_CHECKING:
+    from astralis_des.mission.draws import RoomState
+    from astralis_des.mission.loader import Mission
+    from astralis_des.world.model import World
+
+
+class AssignmentRounds:
+    """The rounds of a :class:`~astralis_des.simulation.core.Simulation` (a part of it)."""
+
+    mission: Mission
+    world: World
+    env: simpy.Environment
+    log: EventLog
+    rooms: dict[str, RoomState]
+    rounds: list[dict[str, Any]]
+    allocation_time: list[float]
+
+    def assignment_round(self, segment: str, rooms: list[str], robots: list[Robot],
+                         exclude: dict[str, set[str]] | None = None) -> Assignment:
+        """Match ``robots`` to ``rooms``; ``exclude`` names the kinds that may not take a room
+        (they searched it and saw too little)."""
+        cfg = self.mission.spec.assignment
+        agents, infos, weights, reachable = self.round_inputs(rooms, robots, exclude)
+        started = time.perf_counter()
+        plan = assign(agents, infos, weights, strategy=cfg.strategy, solver=cfg.solver,
+                      high_risk=cfg.high_risk, high_messiness=cfg.high_messiness,
+                      reachable=reachable, options=cfg.options.model_dump(),
+                      rng=stream(self.mission.spec.seed, "assignment", len(self.rounds) + 1))
+        self.allocation_time.append(time.perf_counter() - started)  # wall: not in the log
+        self.record_round(segment, cfg.strategy, plan, infos)
+        return plan
+
+    def round_inputs(self, rooms: list[str], robots: list[Robot],
+                     exclude: dict[str, set[str]] | None = None
+                     ) -> tuple[list[Agent], list[RoomInfo], Weights, np.ndarray]:
+        """What a round is given: the agents where they stand, the rooms as drawn, the
+        mission's weights and who may take which room (reaches it, not ``exclude``d)."""
+        cfg = self.mission.spec.assignment
+        exclude = exclude or {}
+        agents = [Agent(r.id, r.kind, _xyz(r.position(self.env.now))) for r in robots]
+        infos = [RoomInfo(rid, self.world.rooms[rid].center, self.rooms[rid].risk,
+                          self.rooms[rid].messiness, self.world.rooms[rid].area)
+                 for rid in rooms]
+        weights = Weights(cfg.weights.risk.model_dump(), cfg.weights.messiness.model_dump())
+        return agents, infos, weights, self.allowed(robots, rooms, exclude)
+
+    def allowed(self, robots: list[Robot], rooms: list[str],
+                exclude: dict[str, set[str]] | None = None) -> np.ndarray:
+        """``(robots, rooms)``: who may take which room: it gets there from where it is, and
+        its kind is not ``exclude``d from the room (it saw too little of it)."""
+        exclude = exclude or {}
+        return np.array([[robot.kind not in exclude.get(rid, ()) and ok
+                          for rid, ok in zip(rooms, self.reaches(robot, rooms), strict=True)]
+                         for robot in robots], dtype=bool).reshape(len(robots), len(rooms))
+
+    def record_round(self, segment: str, strategy: str, plan: Assignment,
+                     infos: list[RoomInfo]) -> None:
+        """A round in ``rounds`` and an ``assignment`` event: who was matched to what."""
+        record: dict[str, Any] = {
+            "round": len(self.rounds) + 1, "t": self.env.now, "segment": segment,
+            "strategy": strategy, "agents": list(plan.agents), "rooms": list(plan.rooms),
+            "risk": [i.risk for i in infos], "messiness": [i.messiness for i in infos],
+            "costs": [[c if np.isfinite(c) else None for c in row] for row in plan.costs.tolist()],
+            "matching": [{"agent": p.agent, "room": p.room, "cost": p.cost, "action": p.action}
+                         for p in plan.pairs],
+            "unassigned": list(plan.unassigned),
+        }
+        if plan.info:  # a planner's report (the paper's strategies have none)
+            record["info"] = plan.info
+        self.rounds.append(record)
+        self.log.emit("assignment", **{k: v for k, v in record.items() if k != "t"})
+
+    def reaches(self, robot: Robot, room_ids: list[str]) -> list[bool]:
+        """Can this robot's kind get to each room from where it is (stairs, ramps, doors)?"""
+        if not room_ids:
+            return []
+        here = self.world.on_floor(robot.position(self.env.now))
+        return self.world.router.reachable_rooms(here, room_ids, robot.kind)
+
+
+def _xyz(p: np.ndarray) -> tuple[float, float, float]:
+    return (float(p[0]), float(p[1]), float(p[2]))
