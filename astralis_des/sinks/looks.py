@@ -15,6 +15,18 @@ from astralis_des.kernel.robot import Robot
 from astralis_des.kinds import KIND_DEFAULTS, KindDefaults
 from astralis_des.registry import Registry
 from astralis_des.sinks import paths
+from astralis_des.sinks.columns import (
+    SOLID,
+    colors,
+    descriptor,
+    floats,
+    rows,
+    send,
+    send_static,
+    strips,
+    times,
+    vectors,
+)
 from astralis_des.world.clutter import Placed
 from astralis_des.world.geometry import Box
 from astralis_des.world.model import World
@@ -115,9 +127,9 @@ def log_body(rr: Any, rec: Any, robot: Robot, color: tuple[int, int, int, int]) 
     yaw = headings(pts, robot.heading)
     quats = np.column_stack([np.zeros(len(yaw)), np.zeros(len(yaw)), np.sin(yaw / 2),
                              np.cos(yaw / 2)])
-    rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE, duration=np.array(
-        robot.trail_t, dtype=float))], columns=rr.Transform3D.columns(translation=pts,
-                                                                       quaternion=quats))
+    send(rec, entity, times(np.array(robot.trail_t, dtype=float)), {
+        descriptor("Transform3D", "translation"): rows(vectors(pts, 3)),
+        descriptor("Transform3D", "quaternion"): rows(vectors(quats, 4))})
     kind = KIND_DEFAULTS[robot.kind]
     LOOKS.get(kind.look)(rr, rec, entity, color, kind)
 
@@ -135,30 +147,31 @@ def _rotorcraft(rr: Any, rec: Any, entity: str, color: Color, kind: KindDefaults
                             np.zeros(UAV_ARMS)])
     arms = [np.array([[0.0, 0.0, 0.0], tip]) for tip in tips]
     nose = [np.array([[0.0, 0.0, 0.0], [UAV_ARM * 1.3, 0.0, 0.0]])]  # its heading
-    rec.log(entity + "/arms", rr.LineStrips3D(arms + nose, colors=[color], radii=0.025),
-            static=True)
-    rec.log(entity + "/rotors", rr.Points3D(tips, colors=[color], radii=0.08), static=True)
+    send_static(rec, entity + "/arms", "LineStrips3D", strips=strips(arms + nose),
+                colors=colors([color]), radii=floats([0.025]))
+    send_static(rec, entity + "/rotors", "Points3D", positions=vectors(tips, 3),
+                colors=colors([color]), radii=floats([0.08]))
 
 
 @LOOKS.register("rover")
 def _rover(rr: Any, rec: Any, entity: str, color: Color, kind: KindDefaults) -> None:
     """A solid hull of its footprint (or its disc's square) and an arrow out of its front."""
     length, width = kind.footprint or (kind.length, kind.length)
-    rec.log(entity + "/hull", rr.Boxes3D(half_sizes=[(length / 2, width / 2, 0.2)],
-                                         centers=[(0.0, 0.0, -0.2)], colors=[color],
-                                         fill_mode="solid"), static=True)
-    rec.log(entity + "/front", rr.Arrows3D(origins=[(0.0, 0.0, 0.05)],
-                                           vectors=[(length / 2 + 0.3, 0.0, 0.0)],
-                                           colors=[(255, 255, 255, 255)]), static=True)
+    send_static(rec, entity + "/hull", "Boxes3D", half_sizes=vectors([(length / 2, width / 2,
+                                                                     0.2)], 3),
+                centers=vectors([(0.0, 0.0, -0.2)], 3), colors=colors([color]),
+                fill_mode=SOLID)
+    send_static(rec, entity + "/front", "Arrows3D", origins=vectors([(0.0, 0.0, 0.05)], 3),
+                vectors=vectors([(length / 2 + 0.3, 0.0, 0.0)], 3),
+                colors=colors([(255, 255, 255, 255)]))
 
 
 @LOOKS.register("person")
 def _person(rr: Any, rec: Any, entity: str, color: Color, kind: KindDefaults) -> None:
     """A standing person's box, its top a little over its eyes."""
-    rec.log(entity + "/person", rr.Boxes3D(half_sizes=[HUMAN_HALF], centers=[
-        (0.0, 0.0, HUMAN_HALF[2] - kind.height)], colors=[color],
-        fill_mode="solid"), static=True)
-
+    send_static(rec, entity + "/person", "Boxes3D", half_sizes=vectors([HUMAN_HALF], 3),
+                centers=vectors([(0.0, 0.0, HUMAN_HALF[2] - kind.height)], 3),
+                colors=colors([color]), fill_mode=SOLID)
 
 
 def by_height(z: np.ndarray, top: float = 12.0) -> np.ndarray:
