@@ -107,11 +107,14 @@ def strips(points: Sequence[np.ndarray]) -> pa.Array:
 
 
 def times(seconds: Any) -> pa.Array:
-    """The simulated time column, as ``rr.TimeColumn`` makes it from what it is given (a
-    list is rounded to the nanosecond, a numpy array cut)."""
-    import rerun as rr
-
-    return rr.TimeColumn(paths.TIMELINE, duration=seconds).as_arrow_array()
+    """The simulated time column, in nanoseconds as ``rr.TimeColumn`` makes it from what it is
+    given: a numpy array's cut, a list's rounded (half to even, as Python's ``round``)."""
+    if isinstance(seconds, np.ndarray):
+        nanos = (seconds * 1e9).astype("timedelta64[ns]")
+    else:
+        nanos = np.round(np.asarray(seconds, dtype=np.float64) * 1e9).astype(
+            np.int64).astype("timedelta64[ns]")
+    return pa.array(nanos, pa.duration("ns"))
 
 
 def send(rec: Any, entity: str, index: pa.Array | None, columns: Columns) -> None:
@@ -123,7 +126,11 @@ def send(rec: Any, entity: str, index: pa.Array | None, columns: Columns) -> Non
                                     recording=rec.to_native())
 
 
+def static_columns(archetype: str, **fields: pa.Array) -> dict[Any, pa.Array]:
+    """The columns of a static chunk of ``archetype`` (each field's values, one row)."""
+    return {descriptor(archetype, name): one_row(values) for name, values in fields.items()}
+
+
 def send_static(rec: Any, entity: str, archetype: str, **fields: pa.Array) -> None:
     """``entity``'s static components of ``archetype`` (each field's values, one row)."""
-    send(rec, entity, None, {descriptor(archetype, name): one_row(values)
-                             for name, values in fields.items()})
+    send(rec, entity, None, static_columns(archetype, **fields))
