@@ -69,8 +69,8 @@ LIVE_PERIOD = 2.0  # s of simulated time between sends to a live viewer
 
 class RerunRecorder:
     """Writes ``recording.rrd``: the world at once, then events, task states and poses in
-    columns when the run closes (also when it is interrupted), since one ``log`` call costs
-    about as much as simulating a whole task."""
+    columns when the run closes (also when it is interrupted), each entity's a chunk built
+    straight into Arrow arrays (:mod:`astralis_des.sinks.columns`)."""
 
     def __init__(self, sim: Simulation, path: Path, view: bool = False) -> None:
         import rerun as rr
