@@ -4,6 +4,7 @@ trails, each robot's task and the events as text, on one ``sim_time`` timeline."
 from __future__ import annotations
 
 from collections.abc import Generator, Mapping, Sequence
+from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -15,6 +16,7 @@ from astralis_des.sinks import paths
 from astralis_des.sinks.blueprint import APPLICATION, Layout, send_layout
 from astralis_des.sinks.columns import (
     SOLID,
+    Columns,
     colors,
     descriptor,
     flags,
@@ -23,6 +25,7 @@ from astralis_des.sinks.columns import (
     rows,
     send,
     send_static,
+    static_columns,
     strips,
     texts,
     times,
@@ -173,8 +176,8 @@ class RerunRecorder:
             pts = np.array(robot.trail_p, dtype=float)
             color = palette[rid]
             log_body(rr, rec, robot, color)
-            send_static(rec, paths.robot_pose(rid), "Points3D", radii=floats([0.35]),
-                        colors=colors([color]), labels=texts([rid]))
+            pose, plan = robot_styles(rid, color)
+            send(rec, paths.robot_pose(rid), None, pose)
             send_static(rec, paths.robot_trail(rid), "LineStrips3D",
                         strips=strips([pts.reshape(-1, 3)]), colors=colors([color]),
                         radii=floats([0.05]))
@@ -182,8 +185,7 @@ class RerunRecorder:
                 send(rec, paths.robot_plan(rid), times([t for t, _ in robot.plans]), {
                     descriptor("LineStrips3D", "strips"): rows(strips(
                         [np.asarray(p, dtype=float).reshape(-1, 3) for _, p in robot.plans]))})
-                send_static(rec, paths.robot_plan(rid), "LineStrips3D",
-                            colors=colors([(*color[:3], 140)]), radii=floats([0.03]))
+                send(rec, paths.robot_plan(rid), None, plan)
         self._log_replay(result, perception)
         close_and_check(rec, self.path)  # Rerun's file sink only logs a failed write
 
@@ -235,6 +237,16 @@ class RerunRecorder:
             cameras=cameras, hidden=above(sim.world, shown),
             sensed=sorted({rid for rid, _ in sim.pose_sensors.sensors}), graph=graph,
             matrix=Grid.largest(sim.rounds).bounds()))
+
+
+@lru_cache(maxsize=256)
+def robot_styles(rid: str, color: tuple[int, int, int, int]) -> tuple[Columns, Columns]:
+    """The static looks of a robot's pose (its colour, labelled) and of its planned path (its
+    colour, faint): the same from run to run, made once."""
+    return (static_columns("Points3D", radii=floats([0.35]), colors=colors([color]),
+                           labels=texts([rid])),
+            static_columns("LineStrips3D", colors=colors([(*color[:3], 140)]),
+                           radii=floats([0.03])))
 
 
 def above(world: World, shown: Sequence[Any]) -> list[str]:

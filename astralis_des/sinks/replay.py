@@ -6,18 +6,21 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 from astralis_des.kernel.events import Record
 from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.sinks import paths
 from astralis_des.sinks.columns import (
+    Columns,
     colors,
     descriptor,
     doubles,
     rows,
     send,
     send_static,
+    static_columns,
     texts,
     times,
 )
@@ -127,13 +130,18 @@ def log_metrics(rr: Any, rec: Any, series: Series,
     for name, (at, values) in series.items():
         entity = paths.mission_metric(name)
         send(rec, entity, times(at), {descriptor("Scalars", "scalars"): rows(doubles(values))})
-        style = "SeriesPoints" if name == "coverage" else "SeriesLines"
         robot = name.split("/", 1)[1] if name.startswith("distance/") else None
-        color = (palette or {}).get(robot or "")
-        looks = {"names": texts([name.replace("_", " ")])}
-        if color is not None:
-            looks["colors"] = colors([color])
-        send_static(rec, entity, style, **looks)
+        send(rec, entity, None, series_style(name, (palette or {}).get(robot or "")))
+
+
+@lru_cache(maxsize=256)
+def series_style(name: str, color: tuple[int, int, int, int] | None) -> Columns:
+    """A series' static looks: points for the coverage, else a line; its name, its colour if
+    it has one (made once)."""
+    looks = {"names": texts([name.replace("_", " ")])}
+    if color is not None:
+        looks["colors"] = colors([color])
+    return static_columns("SeriesPoints" if name == "coverage" else "SeriesLines", **looks)
 
 
 def _hazard(kind: str | None) -> str | None:
