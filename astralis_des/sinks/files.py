@@ -5,13 +5,12 @@ from __future__ import annotations
 
 import contextlib
 import os
-import threading
 import time
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from astralis_des.kernel.events import Record
-from astralis_des.outdir import Staging, checked, result_files, write_failure
+from astralis_des.outdir import Staging, checked, result_files, write_failure, write_file
 from astralis_des.outdir import dumps as strict_dumps
 from astralis_des.simulation.outputs import OUTPUTS
 
@@ -38,11 +37,10 @@ class Outputs:
     opening included, for benchmarks to report their share."""
 
     def __init__(self, outputs: list[Output], seconds: float = 0.0,
-                 stage: Staging | None = None, syncs: Syncs | None = None) -> None:
+                 stage: Staging | None = None) -> None:
         self.outputs = outputs
         self.seconds = seconds
         self.stage = stage
-        self.syncs = syncs or Syncs()
         self.failed: Exception | None = None  # the first failed write: nothing more is written
 
     def on_event(self, record: Record) -> None:
@@ -66,7 +64,6 @@ class Outputs:
                 raise self.failed
             for out in self.outputs:
                 out.close(result)
-            self.syncs.wait()
         except OSError as exc:
             self._abandon()
             raise self._failure(exc) from exc
@@ -82,47 +79,10 @@ class Outputs:
         return write_failure(where, exc)
 
     def _abandon(self) -> None:
-        self.syncs.wait(quiet=True)  # a file being synced is closed by its sync
         for out in self.outputs:
             out.discard()
         if self.stage is not None:
             self.stage.abandon()
-
-
-class Syncs:
-    """The ``fsync`` of each written file, each on a thread of its own, so that the disk
-    works while the recording is made (3 to 7 ms a run, one after the other); :meth:`wait`
-    raises the first that failed (a full disk, an I/O error), before anything is put in
-    place. Each file is closed once synced."""
-
-    def __init__(self) -> None:
-        self._threads: list[threading.Thread] = []
-        self._failed: list[OSError] = []
-
-    def start(self, file: IO[Any]) -> None:
-        """Sync and close ``file`` (its bytes flushed to the system already)."""
-        thread = threading.Thread(target=self._sync, args=(file,), name="astralis-fsync",
-                                  daemon=True)
-        thread.start()
-        self._threads.append(thread)
-
-    def _sync(self, file: IO[Any]) -> None:
-        try:
-            try:
-                os.fsync(file.fileno())
-            finally:
-                file.close()
-        except OSError as exc:
-            self._failed.append(exc)
-
-    def wait(self, *, quiet: bool = False) -> None:
-        """Wait for every sync started; raise the first failure (none with ``quiet``)."""
-        threads, self._threads = self._threads, []
-        for thread in threads:
-            thread.join()
-        failed, self._failed = self._failed, []
-        if failed and not quiet:
-            raise failed[0]
 
 
 class JsonlWriter:
@@ -130,16 +90,16 @@ class JsonlWriter:
     interrupted run keeps every complete line and a reader can follow it (in the staging
     folder, :func:`~astralis_des.outdir.staging_path`, until the run ends)."""
 
-    def __init__(self, path: Path, syncs: Syncs) -> None:
+    def __init__(self, path: Path) -> None:
         self._file = path.open("w", encoding="utf-8", buffering=1)
-        self._syncs = syncs
 
     def on_event(self, record: Record) -> None:
         self._file.write(dumps(record) + "\n")
 
     def close(self, result: RunResult) -> None:
         self._file.flush()
-        self._syncs.start(self._file)
+        os.fsync(self._file.fileno())
+        self._file.close()
 
     def discard(self) -> None:
         with contextlib.suppress(OSError):  # its bytes could not be written: no matter now
@@ -147,25 +107,14 @@ class JsonlWriter:
 
 
 class SummaryWriter:
-    def __init__(self, path: Path, syncs: Syncs) -> None:
+    def __init__(self, path: Path) -> None:
         self.path = path
-        self._syncs = syncs
 
     def on_event(self, record: Record) -> None:
         pass
 
     def close(self, result: RunResult) -> None:
-        """Written whole to the system here (a full disk fails here), synced meanwhile."""
-        text = strict_dumps(result.summary(), indent=2) + "\n"
-        file = self.path.open("w", encoding="utf-8")
-        try:
-            file.write(text)
-            file.flush()
-        except BaseException:
-            with contextlib.suppress(OSError):
-                file.close()
-            raise
-        self._syncs.start(file)
+        write_file(self.path, strict_dumps(result.summary(), indent=2) + "\n")
 
     def discard(self) -> None:
         pass
@@ -182,7 +131,6 @@ def open_sinks(sim: Simulation, out_dir: Path | None) -> Outputs:
     t0 = time.perf_counter()
     outputs: list[Output] = []
     stage = None
-    syncs = Syncs()
     if out_dir is not None:
         cfg = sim.mission.spec.outputs
         stage = Staging(out_dir, owned=OUTPUT_FILES, last="summary.json",
@@ -191,9 +139,9 @@ def open_sinks(sim: Simulation, out_dir: Path | None) -> Outputs:
         try:
             with checked(out_dir):
                 if cfg.events:
-                    outputs.append(JsonlWriter(folder / "events.jsonl", syncs))
+                    outputs.append(JsonlWriter(folder / "events.jsonl"))
                 if cfg.summary:
-                    outputs.append(SummaryWriter(folder / "summary.json", syncs))
+                    outputs.append(SummaryWriter(folder / "summary.json"))
                 if cfg.recording:
                     from astralis_des.sinks.recording import RerunRecorder
 
@@ -207,6 +155,6 @@ def open_sinks(sim: Simulation, out_dir: Path | None) -> Outputs:
                 out.discard()
             stage.abandon()
             raise
-    sinks = Outputs(outputs, time.perf_counter() - t0, stage, syncs)
+    sinks = Outputs(outputs, time.perf_counter() - t0, stage)
     sim.log.sinks.append(sinks.on_event)
     return sinks
