@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from collections import defaultdict
 from collections.abc import Callable, Sequence
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -15,6 +16,19 @@ from astralis_des.kernel.robot import Robot
 from astralis_des.kinds import KIND_DEFAULTS, KindDefaults
 from astralis_des.registry import Registry
 from astralis_des.sinks import paths
+from astralis_des.sinks.columns import (
+    SOLID,
+    Columns,
+    colors,
+    descriptor,
+    floats,
+    rows,
+    send,
+    static_columns,
+    strips,
+    times,
+    vectors,
+)
 from astralis_des.world.clutter import Placed
 from astralis_des.world.geometry import Box
 from astralis_des.world.model import World
@@ -94,15 +108,14 @@ def by_place(world: World, boxes: Sequence[Box]) -> dict[str, list[int]]:
 def headings(points: np.ndarray, start: float) -> np.ndarray:
     """The heading at each trail point: the direction of the leg it ends (the heading before
     for a point that did not move in the plane)."""
-    out = np.empty(len(points))
-    heading = start
-    for i in range(len(points)):
-        if i:
-            dx, dy = points[i, :2] - points[i - 1, :2]
-            if math.hypot(dx, dy) > 1e-6:
-                heading = math.atan2(dy, dx)
-        out[i] = heading
-    return out
+    if len(points) < 2:
+        return np.full(len(points), float(start))
+    steps = points[1:, :2] - points[:-1, :2]
+    moved = np.hypot(steps[:, 0], steps[:, 1]) > 1e-6
+    last = np.maximum.accumulate(np.where(moved, np.arange(len(steps)), -1))  # last move
+    legs = np.arctan2(steps[:, 1], steps[:, 0])
+    return np.concatenate([[float(start)],
+                           np.where(last >= 0, legs[np.maximum(last, 0)], float(start))])
 
 
 def log_body(rr: Any, rec: Any, robot: Robot, color: tuple[int, int, int, int]) -> None:
@@ -115,9 +128,9 @@ def log_body(rr: Any, rec: Any, robot: Robot, color: tuple[int, int, int, int]) 
     yaw = headings(pts, robot.heading)
     quats = np.column_stack([np.zeros(len(yaw)), np.zeros(len(yaw)), np.sin(yaw / 2),
                              np.cos(yaw / 2)])
-    rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE, duration=np.array(
-        robot.trail_t, dtype=float))], columns=rr.Transform3D.columns(translation=pts,
-                                                                       quaternion=quats))
+    send(rec, entity, times(np.array(robot.trail_t, dtype=float)), {
+        descriptor("Transform3D", "translation"): rows(vectors(pts, 3)),
+        descriptor("Transform3D", "quaternion"): rows(vectors(quats, 4))})
     kind = KIND_DEFAULTS[robot.kind]
     LOOKS.get(kind.look)(rr, rec, entity, color, kind)
 
@@ -127,38 +140,61 @@ Color = tuple[int, int, int, int]
 LOOKS: Registry[str, Callable[[Any, Any, str, Color, KindDefaults], None]] = Registry("look")
 
 
+def send_parts(rec: Any, entity: str, parts: dict[str, Columns]) -> None:
+    """Each part of a robot's body, static, under ``entity``."""
+    for part, columns in parts.items():
+        send(rec, f"{entity}/{part}", None, columns)
+
+
+# The built-in looks' columns are the same from run to run: made once per kind and colour.
 @LOOKS.register("rotorcraft")
 def _rotorcraft(rr: Any, rec: Any, entity: str, color: Color, kind: KindDefaults) -> None:
     """Its arms out to the rotors and a nose along its heading."""
+    send_parts(rec, entity, _rotorcraft_parts(color))
+
+
+@lru_cache(maxsize=64)
+def _rotorcraft_parts(color: Color) -> dict[str, Columns]:
     angles = np.arange(UAV_ARMS) * (2 * math.pi / UAV_ARMS) + math.pi / UAV_ARMS
     tips = np.column_stack([UAV_ARM * np.cos(angles), UAV_ARM * np.sin(angles),
                             np.zeros(UAV_ARMS)])
     arms = [np.array([[0.0, 0.0, 0.0], tip]) for tip in tips]
     nose = [np.array([[0.0, 0.0, 0.0], [UAV_ARM * 1.3, 0.0, 0.0]])]  # its heading
-    rec.log(entity + "/arms", rr.LineStrips3D(arms + nose, colors=[color], radii=0.025),
-            static=True)
-    rec.log(entity + "/rotors", rr.Points3D(tips, colors=[color], radii=0.08), static=True)
+    return {"arms": static_columns("LineStrips3D", strips=strips(arms + nose),
+                                   colors=colors([color]), radii=floats([0.025])),
+            "rotors": static_columns("Points3D", positions=vectors(tips, 3),
+                                     colors=colors([color]), radii=floats([0.08]))}
 
 
 @LOOKS.register("rover")
 def _rover(rr: Any, rec: Any, entity: str, color: Color, kind: KindDefaults) -> None:
     """A solid hull of its footprint (or its disc's square) and an arrow out of its front."""
-    length, width = kind.footprint or (kind.length, kind.length)
-    rec.log(entity + "/hull", rr.Boxes3D(half_sizes=[(length / 2, width / 2, 0.2)],
-                                         centers=[(0.0, 0.0, -0.2)], colors=[color],
-                                         fill_mode="solid"), static=True)
-    rec.log(entity + "/front", rr.Arrows3D(origins=[(0.0, 0.0, 0.05)],
-                                           vectors=[(length / 2 + 0.3, 0.0, 0.0)],
-                                           colors=[(255, 255, 255, 255)]), static=True)
+    send_parts(rec, entity, _rover_parts(color, kind.footprint or (kind.length, kind.length)))
+
+
+@lru_cache(maxsize=64)
+def _rover_parts(color: Color, footprint: tuple[float, float]) -> dict[str, Columns]:
+    length, width = footprint
+    return {"hull": static_columns("Boxes3D", half_sizes=vectors([(length / 2, width / 2, 0.2)],
+                                                                 3),
+                                   centers=vectors([(0.0, 0.0, -0.2)], 3),
+                                   colors=colors([color]), fill_mode=SOLID),
+            "front": static_columns("Arrows3D", origins=vectors([(0.0, 0.0, 0.05)], 3),
+                                    vectors=vectors([(length / 2 + 0.3, 0.0, 0.0)], 3),
+                                    colors=colors([(255, 255, 255, 255)]))}
 
 
 @LOOKS.register("person")
 def _person(rr: Any, rec: Any, entity: str, color: Color, kind: KindDefaults) -> None:
     """A standing person's box, its top a little over its eyes."""
-    rec.log(entity + "/person", rr.Boxes3D(half_sizes=[HUMAN_HALF], centers=[
-        (0.0, 0.0, HUMAN_HALF[2] - kind.height)], colors=[color],
-        fill_mode="solid"), static=True)
+    send_parts(rec, entity, _person_parts(color, kind.height))
 
+
+@lru_cache(maxsize=64)
+def _person_parts(color: Color, height: float) -> dict[str, Columns]:
+    return {"person": static_columns("Boxes3D", half_sizes=vectors([HUMAN_HALF], 3),
+                                     centers=vectors([(0.0, 0.0, HUMAN_HALF[2] - height)], 3),
+                                     colors=colors([color]), fill_mode=SOLID)}
 
 
 def by_height(z: np.ndarray, top: float = 12.0) -> np.ndarray:

@@ -2,10 +2,10 @@
 imported blocks, mesh or cloud), prepared once per process and sent to each later recording
 as chunks.
 
-Each ``log`` call of Rerun's Python SDK converts its archetype anew, about 0.1 to 0.5 ms; a
-prepared chunk is sent as it is (the default world's solids: 2.4 ms logged, 0.2 ms sent).
-They are prepared by logging into a throwaway recording saved to a temporary file and read
-back; where that fails (no temporary folder), they are logged as before."""
+Grouping a world's boxes by building and storey and building their columns takes about 2 ms
+for the default world; a prepared chunk is sent as it is (0.03 ms). They are prepared by
+logging into a throwaway recording saved to a temporary file and read back; where that fails
+(no temporary folder), they are logged as before."""
 
 from __future__ import annotations
 

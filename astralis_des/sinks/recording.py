@@ -4,6 +4,7 @@ trails, each robot's task and the events as text, on one ``sim_time`` timeline."
 from __future__ import annotations
 
 from collections.abc import Generator, Mapping, Sequence
+from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -13,6 +14,23 @@ from astralis_des.kernel.catalogue import level_of
 from astralis_des.kernel.events import Record
 from astralis_des.sinks import paths
 from astralis_des.sinks.blueprint import APPLICATION, Layout, send_layout
+from astralis_des.sinks.columns import (
+    SOLID,
+    Columns,
+    colors,
+    descriptor,
+    flags,
+    floats,
+    one_row,
+    rows,
+    send,
+    send_static,
+    static_columns,
+    strips,
+    texts,
+    times,
+    vectors,
+)
 from astralis_des.sinks.looks import (
     ROAD_COLOR,
     by_height,
@@ -54,8 +72,8 @@ LIVE_PERIOD = 2.0  # s of simulated time between sends to a live viewer
 
 class RerunRecorder:
     """Writes ``recording.rrd``: the world at once, then events, task states and poses in
-    columns when the run closes (also when it is interrupted), since one ``log`` call costs
-    about as much as simulating a whole task."""
+    columns when the run closes (also when it is interrupted), each entity's a chunk built
+    straight into Arrow arrays (:mod:`astralis_des.sinks.columns`)."""
 
     def __init__(self, sim: Simulation, path: Path, view: bool = False) -> None:
         import rerun as rr
@@ -93,28 +111,34 @@ class RerunRecorder:
         world = sim.world
         send_prepared(rr, rec, ("solids", id(world)), world, lambda s: log_solids(rr, s, world))
         target = sim.target
-        rec.log(paths.WORLD_TARGET, rr.Points3D([target.position], radii=0.3,
-                                                colors=[(255, 0, 255)],
-                                                labels=[f"target ({target.avatar['color']})"]),
-                static=True)
-        rec.set_time(paths.TIMELINE, duration=0.0)
-        self._log_rooms()
+        send_static(rec, paths.WORLD_TARGET, "Points3D", positions=vectors([target.position], 3),
+                    radii=floats([0.3]), colors=colors([(255, 0, 255)]),
+                    labels=texts([f"target ({target.avatar['color']})"]))
+        self._log_rooms(0.0)
 
     def _log_movers(self, end: float) -> None:
         """Patrolling avatars and moving obstacles, sampled at 2 Hz, in columns."""
-        rr, scene = self.rr, self.sim.scene
-        times = np.arange(0.0, end + 0.5, 0.5)
+        scene = self.sim.scene
+        at = np.arange(0.0, end + 0.5, 0.5)
         for mover in [*scene.movers, *scene.avatar_movers()]:
             path = paths.mover(mover.id)
-            self.rec.send_columns(path, indexes=[rr.TimeColumn(paths.TIMELINE, duration=times)],
-                                  columns=rr.Boxes3D.columns(centers=mover.positions_at(times)))
-            self.rec.log(path, rr.Boxes3D.from_fields(
-                half_sizes=[np.array(mover.size) / 2], labels=[mover.id],
-                colors=[(255, 0, 255, 255) if mover.id == "target" else (200, 120, 40, 255)]),
-                static=True)
+            send(self.rec, path, times(at), {descriptor("Boxes3D", "centers"): rows(vectors(
+                mover.positions_at(at), 3))})
+            send_static(self.rec, path, "Boxes3D",
+                        half_sizes=vectors([np.array(mover.size) / 2], 3),
+                        labels=texts([mover.id]),
+                        colors=colors([(255, 0, 255, 255) if mover.id == "target" else
+                                       (200, 120, 40, 255)]))
 
-    def _log_rooms(self) -> None:
-        log_rooms(self.rr, self.rec, self.sim.world, self.sim.rooms)
+    def _log_rooms(self, at: float) -> None:
+        """The rooms, as they are at ``at``."""
+        lo, hi, shades, labels = room_boxes(self.sim.world, self.sim.rooms)
+        send(self.rec, paths.WORLD_ROOMS, times([at]), {
+            descriptor("Boxes3D", "centers"): one_row(vectors((lo + hi) / 2, 3)),
+            descriptor("Boxes3D", "half_sizes"): one_row(vectors((hi - lo) / 2, 3)),
+            descriptor("Boxes3D", "colors"): one_row(colors(shades)),
+            descriptor("Boxes3D", "labels"): one_row(texts(labels)),
+            descriptor("Boxes3D", "show_labels"): one_row(flags([False]))})
 
     def _text(self, entity: str) -> _TextColumn:
         return self._texts.setdefault(entity, _TextColumn())
@@ -130,8 +154,7 @@ class RerunRecorder:
             self._text(paths.robot_task(robot)).add(t, f"{state} {record.get('room') or ''}",
                                                     level)
         if kind == "room_change":
-            self.rec.set_time(paths.TIMELINE, duration=t)
-            self._log_rooms()
+            self._log_rooms(t)
 
     def close(self, result: RunResult) -> None:
         rr, rec = self.rr, self.rec
@@ -139,9 +162,8 @@ class RerunRecorder:
         navigator = self.sim.navigator
         if navigator.map_built:  # the planner's occupancy map, when this run used it
             points = navigator.occupied_points()
-            rec.log(paths.WORLD_OCCUPANCY, rr.Points3D(points, radii=0.1,
-                                                       colors=by_height(points[:, 2])),
-                    static=True)
+            send_static(rec, paths.WORLD_OCCUPANCY, "Points3D", positions=vectors(points, 3),
+                        radii=floats([0.1]), colors=colors(by_height(points[:, 2])))
         self._log_movers(result.end_time)
         perception = self.sim.cosim.perception
         if perception is not None:
@@ -154,16 +176,16 @@ class RerunRecorder:
             pts = np.array(robot.trail_p, dtype=float)
             color = palette[rid]
             log_body(rr, rec, robot, color)
-            rec.log(paths.robot_pose(rid), rr.Points3D.from_fields(
-                radii=0.35, colors=[color], labels=[rid]), static=True)
-            rec.log(paths.robot_trail(rid), rr.LineStrips3D([pts], colors=[color], radii=0.05),
-                    static=True)
+            pose, plan = robot_styles(rid, color)
+            send(rec, paths.robot_pose(rid), None, pose)
+            send_static(rec, paths.robot_trail(rid), "LineStrips3D",
+                        strips=strips([pts.reshape(-1, 3)]), colors=colors([color]),
+                        radii=floats([0.05]))
             if robot.plans:  # each leg's planned path, from when it was set out on
-                rec.send_columns(paths.robot_plan(rid), indexes=[rr.TimeColumn(
-                    paths.TIMELINE, duration=[t for t, _ in robot.plans])],
-                    columns=rr.LineStrips3D.columns(strips=[p for _, p in robot.plans]))
-                rec.log(paths.robot_plan(rid), rr.LineStrips3D.from_fields(
-                    colors=[(*color[:3], 140)], radii=0.03), static=True)
+                send(rec, paths.robot_plan(rid), times([t for t, _ in robot.plans]), {
+                    descriptor("LineStrips3D", "strips"): rows(strips(
+                        [np.asarray(p, dtype=float).reshape(-1, 3) for _, p in robot.plans]))})
+                send(rec, paths.robot_plan(rid), None, plan)
         self._log_replay(result, perception)
         close_and_check(rec, self.path)  # Rerun's file sink only logs a failed write
 
@@ -173,23 +195,21 @@ class RerunRecorder:
 
     def _send_new(self) -> None:
         """Send the rows of the text and pose columns not sent yet."""
-        rr, rec = self.rr, self.rec
+        rec = self.rec
         for entity, column in self._texts.items():
             start = self._sent.get(entity, 0)
             if start < len(column.times):
-                rec.send_columns(entity, indexes=[rr.TimeColumn(
-                    paths.TIMELINE, duration=column.times[start:])],
-                    columns=rr.TextLog.columns(text=column.texts[start:],
-                                               level=column.levels[start:]))
+                send(rec, entity, times(column.times[start:]), {
+                    descriptor("TextLog", "text"): rows(texts(column.texts[start:])),
+                    descriptor("TextLog", "level"): rows(texts(column.levels[start:]))})
                 self._sent[entity] = len(column.times)
         for rid, robot in self.sim.robots.items():
             entity = paths.robot_pose(rid)
             start = self._sent.get(entity, 0)
             if start < len(robot.trail_t):
-                rec.send_columns(entity, indexes=[rr.TimeColumn(
-                    paths.TIMELINE, duration=np.array(robot.trail_t[start:], dtype=float))],
-                    columns=rr.Points3D.columns(
-                        positions=np.array(robot.trail_p[start:], dtype=float)))
+                send(rec, entity, times(np.array(robot.trail_t[start:], dtype=float)), {
+                    descriptor("Points3D", "positions"): rows(vectors(
+                        np.array(robot.trail_p[start:], dtype=float), 3))})
                 self._sent[entity] = len(robot.trail_t)
 
     def _log_replay(self, result: RunResult, perception: Any) -> None:
@@ -217,6 +237,16 @@ class RerunRecorder:
             cameras=cameras, hidden=above(sim.world, shown),
             sensed=sorted({rid for rid, _ in sim.pose_sensors.sensors}), graph=graph,
             matrix=Grid.largest(sim.rounds).bounds()))
+
+
+@lru_cache(maxsize=256)
+def robot_styles(rid: str, color: tuple[int, int, int, int]) -> tuple[Columns, Columns]:
+    """The static looks of a robot's pose (its colour, labelled) and of its planned path (its
+    colour, faint): the same from run to run, made once."""
+    return (static_columns("Points3D", radii=floats([0.35]), colors=colors([color]),
+                           labels=texts([rid])),
+            static_columns("LineStrips3D", colors=colors([(*color[:3], 140)]),
+                           radii=floats([0.03])))
 
 
 def above(world: World, shown: Sequence[Any]) -> list[str]:
@@ -261,29 +291,37 @@ def log_solids(rr: Any, rec: Any, world: World) -> None:
         mine = [solids[i] for i in idx]
         lo = np.array([s.box.lo for s in mine]).reshape(-1, 3)
         hi = np.array([s.box.hi for s in mine]).reshape(-1, 3)
-        colors = [solid_color(s.kind) for s in mine]
-        rec.log(paths.world_part(place, "solids"), rr.Boxes3D(
-            centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2, colors=colors, fill_mode="solid"),
-            static=True)
+        send_static(rec, paths.world_part(place, "solids"), "Boxes3D",
+                    centers=vectors((lo + hi) / 2, 3), half_sizes=vectors((hi - lo) / 2, 3),
+                    colors=colors([solid_color(s.kind) for s in mine]), fill_mode=SOLID)
     if world.surfaces:
         lo = np.array([s.box.lo for s in world.surfaces])
         hi = np.array([s.box.hi for s in world.surfaces])
-        rec.log(paths.WORLD_ROADS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
-                                              colors=[ROAD_COLOR], fill_mode="solid"),
-                static=True)
+        send_static(rec, paths.WORLD_ROADS, "Boxes3D", centers=vectors((lo + hi) / 2, 3),
+                    half_sizes=vectors((hi - lo) / 2, 3), colors=colors([ROAD_COLOR]),
+                    fill_mode=SOLID)
     log_imported(rr, rec, world)
 
 
-def log_rooms(rr: Any, rec: Any, world: World, states: Mapping[str, Any]) -> None:
-    """Rooms as translucent boxes, red by risk and blue by messiness, labelled."""
+def room_boxes(world: World, states: Mapping[str, Any]) -> tuple[
+        np.ndarray, np.ndarray, list[tuple[int, int, int, int]], list[str]]:
+    """The rooms in id order, their corners (low, high), colours (red by risk, blue by
+    messiness, translucent) and labels."""
     ids = sorted(world.rooms)
     lo = np.array([world.rooms[r].box.lo for r in ids])
     hi = np.array([world.rooms[r].box.hi for r in ids])
-    colors = [(int(255 * states[r].risk), 60, int(255 * states[r].messiness), 90) for r in ids]
+    shades = [(int(255 * states[r].risk), 60, int(255 * states[r].messiness), 90) for r in ids]
     labels = [f"{r} risk {states[r].risk:.2f} mess {states[r].messiness:.2f} "
               f"{states[r].sound}" for r in ids]
+    return lo, hi, shades, labels
+
+
+def log_rooms(rr: Any, rec: Any, world: World, states: Mapping[str, Any]) -> None:
+    """Rooms as translucent boxes, red by risk and blue by messiness, labelled (at the
+    recording's time)."""
+    lo, hi, shades, labels = room_boxes(world, states)
     rec.log(paths.WORLD_ROOMS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
-                                          colors=colors, labels=labels, show_labels=False))
+                                          colors=shades, labels=labels, show_labels=False))
 
 
 def log_furniture(rr: Any, rec: Any, placed: Sequence[Placed], world: World) -> None:
@@ -293,9 +331,9 @@ def log_furniture(rr: Any, rec: Any, placed: Sequence[Placed], world: World) -> 
         mine = [placed[i] for i in idx]
         lo = np.array([p.box.lo for p in mine])
         hi = np.array([p.box.hi for p in mine])
-        colors = [placed_color(p) for p in mine]
         labels = [p.kind if p.kind != "avatar" else
                   "avatar " + " ".join(str(v) for _, v in p.attributes) for p in mine]
-        rec.log(paths.world_part(place, "furniture"), rr.Boxes3D(
-            centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2, colors=colors, labels=labels,
-            show_labels=False, fill_mode="solid"), static=True)
+        send_static(rec, paths.world_part(place, "furniture"), "Boxes3D",
+                    centers=vectors((lo + hi) / 2, 3), half_sizes=vectors((hi - lo) / 2, 3),
+                    colors=colors([placed_color(p) for p in mine]), labels=texts(labels),
+                    show_labels=flags([False]), fill_mode=SOLID)

@@ -6,11 +6,24 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 from astralis_des.kernel.events import Record
 from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.sinks import paths
+from astralis_des.sinks.columns import (
+    Columns,
+    colors,
+    descriptor,
+    doubles,
+    rows,
+    send,
+    send_static,
+    static_columns,
+    texts,
+    times,
+)
 
 IDLE, MOVING, FAILED, FAULTED = "idle", "moving", "failed", "faulted"
 LANE_COLORS = {IDLE: (150, 150, 150), MOVING: (70, 150, 255), FAILED: (230, 60, 60),
@@ -56,11 +69,11 @@ def log_lanes(rr: Any, rec: Any, lanes: Mapping[str, Lane]) -> None:
     for rid, lane in lanes.items():
         entity = paths.robot_state(rid)
         values = sorted(set(lane.states))
-        rec.log(entity, rr.StateConfiguration(
-            values=values, labels=values,
-            colors=[LANE_COLORS.get(v, SEARCH_COLOR) for v in values]), static=True)
-        rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE, duration=lane.times)],
-                         columns=rr.StateChange.columns(state=lane.states))
+        send_static(rec, entity, "StateConfiguration", values=texts(values),
+                    labels=texts(values),
+                    colors=colors([LANE_COLORS.get(v, SEARCH_COLOR) for v in values]))
+        send(rec, entity, times(lane.times),
+             {descriptor("StateChange", "state"): rows(texts(lane.states))})
 
 
 Series = dict[str, tuple[list[float], list[float]]]
@@ -112,17 +125,23 @@ def metrics(records: Sequence[Record], rounds: Sequence[Mapping[str, Any]],
 
 
 def log_metrics(rr: Any, rec: Any, series: Series,
-                colors: dict[str, tuple[int, int, int, int]] | None = None) -> None:
-    """Each series on the timeline; a robot's distance in its colour (``colors``)."""
-    for name, (times, values) in series.items():
+                palette: dict[str, tuple[int, int, int, int]] | None = None) -> None:
+    """Each series on the timeline; a robot's distance in its colour (``palette``)."""
+    for name, (at, values) in series.items():
         entity = paths.mission_metric(name)
-        rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE, duration=times)],
-                         columns=rr.Scalars.columns(scalars=values))
-        style = rr.SeriesPoints if name == "coverage" else rr.SeriesLines
+        send(rec, entity, times(at), {descriptor("Scalars", "scalars"): rows(doubles(values))})
         robot = name.split("/", 1)[1] if name.startswith("distance/") else None
-        color = (colors or {}).get(robot or "")
-        rec.log(entity, style(names=[name.replace("_", " ")], colors=[color])
-                if color is not None else style(names=[name.replace("_", " ")]), static=True)
+        send(rec, entity, None, series_style(name, (palette or {}).get(robot or "")))
+
+
+@lru_cache(maxsize=256)
+def series_style(name: str, color: tuple[int, int, int, int] | None) -> Columns:
+    """A series' static looks: points for the coverage, else a line; its name, its colour if
+    it has one (made once)."""
+    looks = {"names": texts([name.replace("_", " ")])}
+    if color is not None:
+        looks["colors"] = colors([color])
+    return static_columns("SeriesPoints" if name == "coverage" else "SeriesLines", **looks)
 
 
 def _hazard(kind: str | None) -> str | None:

@@ -10,9 +10,21 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import pyarrow as pa
 
 from astralis_des.kinds import KIND_DEFAULTS
 from astralis_des.sinks import paths
+from astralis_des.sinks.columns import (
+    colors,
+    descriptor,
+    flags,
+    floats,
+    rows,
+    send,
+    texts,
+    times,
+    vectors,
+)
 
 GRAPH_AGENTS = 6  # up to this many agents in the team, the rounds are drawn as graphs too
 NARROW = 6  # rooms: up to this many in a round, every cell of its matrix shows its cost
@@ -29,9 +41,9 @@ def log_rounds(rr: Any, rec: Any, rounds: Sequence[Mapping[str, Any]],
     ``mission/assignment/graph``."""
     log_matrices(rr, rec, [Matrix.of(record, kinds) for record in rounds
                            if record["agents"] and record["rooms"]])
-    for record in rounds if graph else ():
-        rec.set_time(paths.TIMELINE, duration=record["t"])
-        log_graph(rr, rec, record, kinds)
+    if graph and rounds:
+        log_graphs(rec, [record["t"] for record in rounds],
+                   [Graph.of(record, kinds) for record in rounds])
 
 
 @dataclass(frozen=True)
@@ -131,83 +143,147 @@ class Matrix:
                       [((j + 0.5) * grid.cell, i + 0.5) for i, j in picked], names)
 
 
+IMAGE_FORMAT = pa.struct([pa.field("width", pa.uint32(), nullable=False),
+                          pa.field("height", pa.uint32(), nullable=False),
+                          pa.field("pixel_format", pa.uint8()),
+                          pa.field("color_model", pa.uint8()),
+                          pa.field("channel_datatype", pa.uint8())])
+RGB, U8 = 2, 6  # rr.ColorModel.RGB, rr.ChannelDatatype.U8
+BYTES = pa.list_(pa.field("item", pa.uint8(), nullable=False))
+
+
 def log_matrices(rr: Any, rec: Any, matrices: Sequence[Matrix]) -> None:
     """The rounds' matrices in one column per entity (a chunk each, the looks in every row
     rather than a static chunk more): ``heat`` (the image and its stretch), ``costs`` (labels
     hung from the cells' tops, so that each fills its cell), ``chosen`` (a green box round
     each chosen cell) and ``names``."""
-    from rerun.components import ImageFormat
-
     if not matrices:
         return
     entity, n = paths.MISSION_MATRIX, len(matrices)
-    index = [rr.TimeColumn(paths.TIMELINE, duration=[m.t for m in matrices])]
-    rec.send_columns(f"{entity}/heat", indexes=index, columns=[
-        *rr.Image.columns(buffer=[m.heat.ravel() for m in matrices], format=[
-            ImageFormat(width=m.grid.rooms, height=m.grid.agents, color_model="RGB",
-                        channel_datatype="U8") for m in matrices]),
-        *rr.Transform3D.columns(scale=[(m.grid.cell, 1.0, 1.0) for m in matrices])])
+    index = times([m.t for m in matrices])
+    heat = [m.heat.ravel() for m in matrices]
+    sizes = np.array([len(h) for h in heat], dtype=np.int32)
+    offsets = np.zeros(n + 1, dtype=np.int32)
+    np.cumsum(sizes, out=offsets[1:])
+    nothing = pa.nulls(n, pa.uint8())
+    send(rec, f"{entity}/heat", index, {
+        descriptor("Image", "buffer"): rows(pa.ListArray.from_arrays(
+            pa.array(offsets, pa.int32()), pa.array(np.concatenate(heat), pa.uint8()),
+            type=BYTES)),
+        descriptor("Image", "format"): rows(pa.StructArray.from_arrays([
+            pa.array([m.grid.rooms for m in matrices], pa.uint32()),
+            pa.array([m.grid.agents for m in matrices], pa.uint32()), nothing,
+            pa.array([RGB] * n, pa.uint8()), pa.array([U8] * n, pa.uint8())],
+            fields=list(IMAGE_FORMAT))),
+        descriptor("Transform3D", "scale"): rows(vectors(
+            [(m.grid.cell, 1.0, 1.0) for m in matrices], 3))})
+    each = [len(m.costs) for m in matrices]
     costs = [c for m in matrices for c in m.costs]
-    rec.send_columns(f"{entity}/costs", indexes=index, columns=[
-        *rr.Points2D.columns(positions=np.array([p for p, _ in costs]).reshape(-1, 2),
-                             labels=[text for _, text in costs]).partition(
-            [len(m.costs) for m in matrices]),
-        *rr.Points2D.columns(radii=[0.0] * n, colors=[(255, 255, 255)] * n,
-                             show_labels=[True] * n, draw_order=[20.0] * n)])
-    boxes = [(m.grid.cell / 2 - 0.08, 0.42) for m in matrices for _ in m.chosen]
-    rec.send_columns(f"{entity}/chosen", indexes=index, columns=[
-        *rr.Boxes2D.columns(centers=np.array([c for m in matrices for c in m.chosen]).reshape(
-            -1, 2), half_sizes=np.array(boxes).reshape(-1, 2)).partition(
-            [len(m.chosen) for m in matrices]),
-        *rr.Boxes2D.columns(colors=[CHOSEN] * n, radii=[0.09] * n, draw_order=[30.0] * n)])
+    send(rec, f"{entity}/costs", index, {
+        descriptor("Points2D", "positions"): rows(vectors(
+            np.array([p for p, _ in costs]).reshape(-1, 2), 2), each),
+        descriptor("Points2D", "labels"): rows(texts([text for _, text in costs]), each),
+        descriptor("Points2D", "radii"): rows(floats([0.0] * n)),
+        descriptor("Points2D", "colors"): rows(colors([(255, 255, 255)] * n)),
+        descriptor("Points2D", "show_labels"): rows(flags([True] * n)),
+        descriptor("Points2D", "draw_order"): rows(floats([20.0] * n))})
+    each = [len(m.chosen) for m in matrices]
+    send(rec, f"{entity}/chosen", index, {
+        descriptor("Boxes2D", "centers"): rows(vectors(
+            np.array([c for m in matrices for c in m.chosen]).reshape(-1, 2), 2), each),
+        descriptor("Boxes2D", "half_sizes"): rows(vectors(
+            np.array([(m.grid.cell / 2 - 0.08, 0.42) for m in matrices
+                      for _ in m.chosen]).reshape(-1, 2), 2), each),
+        descriptor("Boxes2D", "colors"): rows(colors([CHOSEN] * n)),
+        descriptor("Boxes2D", "radii"): rows(floats([0.09] * n)),
+        descriptor("Boxes2D", "draw_order"): rows(floats([30.0] * n))})
+    each = [len(m.names) for m in matrices]
     names = [name for m in matrices for name in m.names]
-    rec.send_columns(f"{entity}/names", indexes=index, columns=[
-        *rr.Points2D.columns(positions=[p for p, _, _ in names],
-                             labels=[text for _, text, _ in names],
-                             colors=[color for _, _, color in names]).partition(
-            [len(m.names) for m in matrices]),
-        *rr.Points2D.columns(radii=[0.0] * n, show_labels=[True] * n)])
+    send(rec, f"{entity}/names", index, {
+        descriptor("Points2D", "positions"): rows(vectors(
+            np.array([p for p, _, _ in names]).reshape(-1, 2), 2), each),
+        descriptor("Points2D", "labels"): rows(texts([text for _, text, _ in names]), each),
+        descriptor("Points2D", "colors"): rows(colors([color for _, _, color in names]), each),
+        descriptor("Points2D", "radii"): rows(floats([0.0] * n)),
+        descriptor("Points2D", "show_labels"): rows(flags([True] * n))})
 
 
-def log_graph(rr: Any, rec: Any, record: Mapping[str, Any], kinds: Mapping[str, str]) -> None:
-    """The round's bipartite graph: agents on the left, rooms on the right, and between them
+@dataclass(frozen=True)
+class Graph:
+    """A round's bipartite graph: agents on the left, rooms on the right, and between them
     one small node per edge labelled with Eq. 1's cost; the chosen pairs' cost nodes are large
     and green, the others small and grey."""
-    agents, rooms = list(record["agents"]), list(record["rooms"])
-    ids, positions, labels, colors, radii = [], [], [], [], []
-    edges: list[tuple[str, str]] = []
-    for i, agent in enumerate(agents):
-        ids.append(agent)
-        positions.append((0.0, 100.0 * i))
-        labels.append(f"{agent} ({kinds.get(agent, '?')})")
-        colors.append(_color(kinds.get(agent)))
-        radii.append(12.0)
-    for j, room in enumerate(rooms):
-        ids.append(room)
-        positions.append((600.0, 100.0 * j + 50.0 * (len(agents) - len(rooms))))
-        labels.append(f"{room} risk {record['risk'][j]:.2f} mess "
-                      f"{record['messiness'][j]:.2f}")
-        colors.append((int(255 * record["risk"][j]), 60, int(255 * record["messiness"][j])))
-        radii.append(12.0)
-    chosen = {(m["agent"], m["room"]) for m in record["matching"]}
-    for i, agent in enumerate(agents):
+
+    ids: list[str]
+    positions: list[tuple[float, float]]
+    labels: list[str]
+    colors: list[tuple[int, int, int]]
+    radii: list[float]
+    edges: list[tuple[str, str]]
+
+    @staticmethod
+    def of(record: Mapping[str, Any], kinds: Mapping[str, str]) -> Graph:
+        agents, rooms = list(record["agents"]), list(record["rooms"])
+        graph = Graph([], [], [], [], [], [])
+        ids, positions, labels, colors, radii = (graph.ids, graph.positions, graph.labels,
+                                                 graph.colors, graph.radii)
+        for i, agent in enumerate(agents):
+            ids.append(agent)
+            positions.append((0.0, 100.0 * i))
+            labels.append(f"{agent} ({kinds.get(agent, '?')})")
+            colors.append(_color(kinds.get(agent)))
+            radii.append(12.0)
         for j, room in enumerate(rooms):
-            cost = record["costs"][i][j]
-            if cost is None:
-                continue
-            node = f"{agent}->{room}"
-            share = 0.3 + 0.4 * (j + 1) / (len(rooms) + 1)
-            a, b = np.array(positions[i]), np.array(positions[len(agents) + j])
-            ids.append(node)
-            positions.append(tuple(a + share * (b - a)))
-            picked = (agent, room) in chosen
-            labels.append(f"{cost:.2f}" + (" chosen" if picked else ""))
-            colors.append(CHOSEN if picked else (110, 110, 110))
-            radii.append(8.0 if picked else 3.0)
-            edges += [(agent, node), (node, room)]
-    rec.log(paths.MISSION_GRAPH, rr.GraphNodes(ids, positions=positions, labels=labels,
-                                               colors=colors, radii=radii),
-            rr.GraphEdges(edges, graph_type="directed"))
+            ids.append(room)
+            positions.append((600.0, 100.0 * j + 50.0 * (len(agents) - len(rooms))))
+            labels.append(f"{room} risk {record['risk'][j]:.2f} mess "
+                          f"{record['messiness'][j]:.2f}")
+            colors.append((int(255 * record["risk"][j]), 60, int(255 * record["messiness"][j])))
+            radii.append(12.0)
+        chosen = {(m["agent"], m["room"]) for m in record["matching"]}
+        for i, agent in enumerate(agents):
+            for j, room in enumerate(rooms):
+                cost = record["costs"][i][j]
+                if cost is None:
+                    continue
+                node = f"{agent}->{room}"
+                share = 0.3 + 0.4 * (j + 1) / (len(rooms) + 1)
+                (ax, ay), (bx, by) = positions[i], positions[len(agents) + j]
+                ids.append(node)
+                positions.append((ax + share * (bx - ax), ay + share * (by - ay)))
+                picked = (agent, room) in chosen
+                labels.append(f"{cost:.2f}" + (" chosen" if picked else ""))
+                colors.append(CHOSEN if picked else (110, 110, 110))
+                radii.append(8.0 if picked else 3.0)
+                graph.edges.extend([(agent, node), (node, room)])
+        return graph
+
+
+EDGE = pa.struct([pa.field("first", pa.utf8(), nullable=False),
+                  pa.field("second", pa.utf8(), nullable=False)])
+DIRECTED = 2  # rr.components.GraphType.Directed
+
+
+def log_graphs(rec: Any, at: Sequence[float], graphs: Sequence[Graph]) -> None:
+    """The rounds' graphs (at their times ``at``) at ``mission/assignment/graph``, a row each."""
+    nodes = [len(g.ids) for g in graphs]
+    edges = [e for g in graphs for e in g.edges]
+    send(rec, paths.MISSION_GRAPH, times(list(at)), {
+        descriptor("GraphNodes", "node_ids"): rows(texts([i for g in graphs for i in g.ids]),
+                                                   nodes),
+        descriptor("GraphNodes", "positions"): rows(vectors(
+            np.array([p for g in graphs for p in g.positions]).reshape(-1, 2), 2), nodes),
+        descriptor("GraphNodes", "labels"): rows(texts([x for g in graphs for x in g.labels]),
+                                                 nodes),
+        descriptor("GraphNodes", "colors"): rows(colors(
+            np.array([c for g in graphs for c in g.colors]).reshape(-1, 3)), nodes),
+        descriptor("GraphNodes", "radii"): rows(floats([r for g in graphs for r in g.radii]),
+                                                nodes),
+        descriptor("GraphEdges", "edges"): rows(pa.StructArray.from_arrays(
+            [texts([a for a, _ in edges]), texts([b for _, b in edges])], fields=list(EDGE)),
+            [len(g.edges) for g in graphs]),
+        descriptor("GraphEdges", "graph_type"): rows(pa.array([DIRECTED] * len(graphs),
+                                                              pa.uint8()))})
 
 
 def _color(kind: str | None) -> tuple[int, int, int]:

@@ -13,6 +13,7 @@ import numpy as np
 
 from astralis_des.kernel.events import Record
 from astralis_des.sinks import paths
+from astralis_des.sinks.columns import colors, descriptor, floats, rows, send, texts, times, vectors
 from astralis_des.sinks.looks import by_height
 
 if TYPE_CHECKING:
@@ -106,14 +107,18 @@ def log_detections(rr: Any, rec: Any, records: list[Record]) -> None:
     hits = [r for r in records if r["kind"] == "detection"]
     if not hits:
         return
-    for hit in hits:
-        rec.set_time(paths.TIMELINE, duration=hit["t"])
-        origin = np.asarray(hit["robot_position"], dtype=float)
-        estimate = np.asarray(hit["estimate"], dtype=float)
-        rec.log(paths.MISSION_DETECTIONS, rr.Points3D(
-            [estimate], radii=0.25, colors=[(255, 40, 40)],
-            labels=[f"{hit['robot']} saw the target (error {hit['error']:.2f} m)"]),
-            rr.Arrows3D(origins=[origin], vectors=[estimate - origin], colors=[(255, 40, 40)]))
+    origins = np.array([hit["robot_position"] for hit in hits], dtype=float).reshape(-1, 3)
+    estimates = np.array([hit["estimate"] for hit in hits], dtype=float).reshape(-1, 3)
+    red = colors([(255, 40, 40)] * len(hits))
+    send(rec, paths.MISSION_DETECTIONS, times([hit["t"] for hit in hits]), {
+        descriptor("Points3D", "positions"): rows(vectors(estimates, 3)),
+        descriptor("Points3D", "radii"): rows(floats([0.25] * len(hits))),
+        descriptor("Points3D", "colors"): rows(red),
+        descriptor("Points3D", "labels"): rows(texts([
+            f"{hit['robot']} saw the target (error {hit['error']:.2f} m)" for hit in hits])),
+        descriptor("Arrows3D", "origins"): rows(vectors(origins, 3)),
+        descriptor("Arrows3D", "vectors"): rows(vectors(estimates - origins, 3)),
+        descriptor("Arrows3D", "colors"): rows(red)})
 
 
 def log_pose_sensors(rr: Any, rec: Any, sensors: PoseSensors) -> None:
