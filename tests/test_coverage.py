@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -14,7 +16,7 @@ from astralis_des.sensing import GeometricSensor
 from astralis_des.view import View
 from astralis_des.world import coverage as cov
 from astralis_des.world.catalogue import default_catalogue
-from astralis_des.world.geometry import Box
+from astralis_des.world.geometry import Box, cross2
 from astralis_des.world.model import World
 from astralis_des.world.scene import Scene
 
@@ -300,3 +302,15 @@ def test_a_sweep_flown_again_in_a_room_furnished_anew_covers_what_it_would_afres
                                         seed=seed).coverage(r, pts, room)
     assert len({shares[True, s] for s in range(4)}) > 1  # the furniture differs by seed
     assert all(shares[True, s] == shares[False, s] for s in range(4))
+
+
+def test_the_2d_cross_product_is_numpys_to_the_bit() -> None:
+    """``cross2`` (what coverage's turns and an interior's reflex corners use, since NumPy 2
+    deprecates ``np.cross`` of 2-D vectors) gives ``np.cross``'s bits."""
+    rng = np.random.default_rng(0)
+    a, b = rng.normal(size=(500, 2)), rng.normal(size=(500, 2))
+    a[:5] = 0.0  # signed zeros too
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        expected = np.cross(a, b)
+    assert cross2(a, b).tobytes() == expected.tobytes()

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from astralis_des.world.geometry import Box, FloatArray, inside_polygon
+from astralis_des.world.geometry import Box, FloatArray, cross2, inside_polygon
 
 STEP = 0.25  # m: a pattern is cut to a room's outline at points this far apart
 
@@ -111,7 +111,7 @@ def within(path: FloatArray, outline: tuple[tuple[float, float], ...], margin: f
     kept = dense[inside.all(axis=1)]
     if len(kept) < 3 or np.ptp(kept, axis=0).max() < STEP:
         return path  # too little of it over the room: the pattern as it was
-    turn = np.abs(np.cross(kept[1:-1] - kept[:-2], kept[2:] - kept[1:-1])) > 1e-9
+    turn = np.abs(cross2(kept[1:-1] - kept[:-2], kept[2:] - kept[1:-1])) > 1e-9
     jump = np.linalg.norm(np.diff(kept, axis=0), axis=1) > STEP * 1.01
     keep = np.ones(len(kept), dtype=bool)
     keep[1:-1] = turn | jump[:-1] | jump[1:]

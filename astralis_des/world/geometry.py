@@ -107,6 +107,13 @@ def _slab(origin: FloatArray, d: FloatArray, lo: FloatArray,
     return t_near, t_far
 
 
+def cross2(a: FloatArray, b: FloatArray) -> FloatArray:
+    """The z of ``a x b`` for rows of 2-D vectors: ``np.cross``'s products for them, which
+    NumPy 2 deprecates (the same bits)."""
+    out: FloatArray = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
+
+
 def polyline_length(points: FloatArray) -> float:
     if len(points) < 2:
         return 0.0

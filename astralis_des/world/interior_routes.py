@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from astralis_des.world.geometry import FloatArray, inside_polygon
+from astralis_des.world.geometry import FloatArray, cross2, inside_polygon
 from astralis_des.world.parts import Door, InteriorPlan
 
 CORNER = 0.8  # m from a reflex corner, inwards, where a route turns round it: clear of both
@@ -28,7 +28,7 @@ def reflex_corners(outline: FloatArray, inset: float = CORNER) -> FloatArray:
         return np.zeros((0, 2))
     before, after = np.roll(p, 1, axis=0), np.roll(p, -1, axis=0)
     area = float(np.sum(p[:, 0] * after[:, 1] - after[:, 0] * p[:, 1]))  # twice, signed
-    turn = np.cross(p - before, after - p)
+    turn = cross2(p - before, after - p)
     reflex = turn * np.sign(area) < -1e-12
     back = _unit(before - p) + _unit(after - p)
     inward = -_unit(back)
