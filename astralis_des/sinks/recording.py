@@ -114,7 +114,7 @@ class RerunRecorder:
         send_static(rec, paths.WORLD_TARGET, "Points3D", positions=vectors([target.position], 3),
                     radii=floats([0.3]), colors=colors([(255, 0, 255)]),
                     labels=texts([f"target ({target.avatar['color']})"]))
-        self._log_rooms(0.0)
+        log_rooms(rec, self.sim.world, self.sim.rooms, 0.0)
 
     def _log_movers(self, end: float) -> None:
         """Patrolling avatars and moving obstacles, sampled at 2 Hz, in columns."""
@@ -130,16 +130,6 @@ class RerunRecorder:
                         colors=colors([(255, 0, 255, 255) if mover.id == "target" else
                                        (200, 120, 40, 255)]))
 
-    def _log_rooms(self, at: float) -> None:
-        """The rooms, as they are at ``at``."""
-        lo, hi, shades, labels = room_boxes(self.sim.world, self.sim.rooms)
-        send(self.rec, paths.WORLD_ROOMS, times([at]), {
-            descriptor("Boxes3D", "centers"): one_row(vectors((lo + hi) / 2, 3)),
-            descriptor("Boxes3D", "half_sizes"): one_row(vectors((hi - lo) / 2, 3)),
-            descriptor("Boxes3D", "colors"): one_row(colors(shades)),
-            descriptor("Boxes3D", "labels"): one_row(texts(labels)),
-            descriptor("Boxes3D", "show_labels"): one_row(flags([False]))})
-
     def _text(self, entity: str) -> _TextColumn:
         return self._texts.setdefault(entity, _TextColumn())
 
@@ -154,11 +144,11 @@ class RerunRecorder:
             self._text(paths.robot_task(robot)).add(t, f"{state} {record.get('room') or ''}",
                                                     level)
         if kind == "room_change":
-            self._log_rooms(t)
+            log_rooms(self.rec, self.sim.world, self.sim.rooms, t)
 
     def close(self, result: RunResult) -> None:
         rr, rec = self.rr, self.rec
-        log_furniture(rr, rec, self.sim.scene.furnished(), self.sim.world)
+        log_furniture(rec, self.sim.scene.furnished(), self.sim.world)
         navigator = self.sim.navigator
         if navigator.map_built:  # the planner's occupancy map, when this run used it
             points = navigator.occupied_points()
@@ -169,7 +159,7 @@ class RerunRecorder:
         if perception is not None:
             log_sensors(rr, rec, perception)
         log_pose_sensors(rr, rec, self.sim.pose_sensors)
-        log_detections(rr, rec, self.sim.log.records)
+        log_detections(rec, self.sim.log.records)
         self._send_new()
         palette = robot_colors(list(self.sim.robots))
         for rid, robot in self.sim.robots.items():
@@ -214,15 +204,15 @@ class RerunRecorder:
 
     def _log_replay(self, result: RunResult, perception: Any) -> None:
         """Task lanes, assignment rounds, metrics, and the layout that shows them."""
-        rr, rec, sim = self.rr, self.rec, self.sim
+        rec, sim = self.rec, self.sim
         kinds = {rid: robot.kind for rid, robot in sim.robots.items()}
         records = sim.log.records
-        log_lanes(rr, rec, task_lanes(records, list(sim.robots)))
+        log_lanes(rec, task_lanes(records, list(sim.robots)))
         graph = len(kinds) <= GRAPH_AGENTS
-        log_rounds(rr, rec, sim.rounds, kinds, graph)
+        log_rounds(rec, sim.rounds, kinds, graph)
         cfg = sim.mission.spec.assignment
-        log_metrics(rr, rec, metrics(records, sim.rounds, kinds, cfg.high_risk,
-                                     cfg.high_messiness), robot_colors(list(sim.robots)))
+        log_metrics(rec, metrics(records, sim.rounds, kinds, cfg.high_risk,
+                                 cfg.high_messiness), robot_colors(list(sim.robots)))
         framed = {f.robot for f in perception.frames} if perception is not None else set()
         cameras = [rid for rid in sim.robots if rid in framed]
         searched = [sim.world.rooms[r] for r in sim.mission.searched_rooms()]
@@ -316,15 +306,20 @@ def room_boxes(world: World, states: Mapping[str, Any]) -> tuple[
     return lo, hi, shades, labels
 
 
-def log_rooms(rr: Any, rec: Any, world: World, states: Mapping[str, Any]) -> None:
-    """Rooms as translucent boxes, red by risk and blue by messiness, labelled (at the
-    recording's time)."""
+def log_rooms(rec: Any, world: World, states: Mapping[str, Any], at: float | None) -> None:
+    """Rooms as translucent boxes, red by risk and blue by messiness, labelled: as they are at
+    ``at`` (None: static, a world shown without a run)."""
     lo, hi, shades, labels = room_boxes(world, states)
-    rec.log(paths.WORLD_ROOMS, rr.Boxes3D(centers=(lo + hi) / 2, half_sizes=(hi - lo) / 2,
-                                          colors=shades, labels=labels, show_labels=False))
+    columns = {descriptor("Boxes3D", "centers"): vectors((lo + hi) / 2, 3),
+               descriptor("Boxes3D", "half_sizes"): vectors((hi - lo) / 2, 3),
+               descriptor("Boxes3D", "colors"): colors(shades),
+               descriptor("Boxes3D", "labels"): texts(labels),
+               descriptor("Boxes3D", "show_labels"): flags([False])}
+    send(rec, paths.WORLD_ROOMS, None if at is None else times([at]),
+         {key: one_row(values) for key, values in columns.items()})
 
 
-def log_furniture(rr: Any, rec: Any, placed: Sequence[Placed], world: World) -> None:
+def log_furniture(rec: Any, placed: Sequence[Placed], world: World) -> None:
     """Furniture and avatars, once (static), by building and storey, coloured by kind (an
     avatar in its Table II colour)."""
     for place, idx in by_place(world, [p.box for p in placed]).items():

@@ -65,7 +65,7 @@ def _state(record: Record) -> str | None:
     return {"fault": FAULTED, "recover": IDLE}.get(kind)
 
 
-def log_lanes(rr: Any, rec: Any, lanes: Mapping[str, Lane]) -> None:
+def log_lanes(rec: Any, lanes: Mapping[str, Lane]) -> None:
     for rid, lane in lanes.items():
         entity = paths.robot_state(rid)
         values = sorted(set(lane.states))
@@ -124,7 +124,7 @@ def metrics(records: Sequence[Record], rounds: Sequence[Mapping[str, Any]],
     return series
 
 
-def log_metrics(rr: Any, rec: Any, series: Series,
+def log_metrics(rec: Any, series: Series,
                 palette: dict[str, tuple[int, int, int, int]] | None = None) -> None:
     """Each series on the timeline; a robot's distance in its colour (``palette``)."""
     for name, (at, values) in series.items():

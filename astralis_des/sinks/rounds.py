@@ -35,12 +35,12 @@ NAME_COLOR = (220, 220, 220)
 CHAR = 0.3  # a label's character, in rows' heights (a row is about 24 px on screen)
 
 
-def log_rounds(rr: Any, rec: Any, rounds: Sequence[Mapping[str, Any]],
+def log_rounds(rec: Any, rounds: Sequence[Mapping[str, Any]],
                kinds: Mapping[str, str], graph: bool) -> None:
     """Every round's matrix at ``mission/assignment/matrix``, and with ``graph`` its graph at
     ``mission/assignment/graph``."""
-    log_matrices(rr, rec, [Matrix.of(record, kinds) for record in rounds
-                           if record["agents"] and record["rooms"]])
+    log_matrices(rec, [Matrix.of(record, kinds) for record in rounds
+                       if record["agents"] and record["rooms"]])
     if graph and rounds:
         log_graphs(rec, [record["t"] for record in rounds],
                    [Graph.of(record, kinds) for record in rounds])
@@ -152,7 +152,7 @@ RGB, U8 = 2, 6  # rr.ColorModel.RGB, rr.ChannelDatatype.U8
 BYTES = pa.list_(pa.field("item", pa.uint8(), nullable=False))
 
 
-def log_matrices(rr: Any, rec: Any, matrices: Sequence[Matrix]) -> None:
+def log_matrices(rec: Any, matrices: Sequence[Matrix]) -> None:
     """The rounds' matrices in one column per entity (a chunk each, the looks in every row
     rather than a static chunk more): ``heat`` (the image and its stretch), ``costs`` (labels
     hung from the cells' tops, so that each fills its cell), ``chosen`` (a green box round

@@ -101,7 +101,7 @@ def _log_preview(rr: Any, rec: Any, entity: str, first: KeptFrame) -> None:
     rec.log(entity, rr.Clear(recursive=False))
 
 
-def log_detections(rr: Any, rec: Any, records: list[Record]) -> None:
+def log_detections(rec: Any, records: list[Record]) -> None:
     """Each detection at its time: the estimate (labelled with its error) and an arrow from
     the robot's camera to it."""
     hits = [r for r in records if r["kind"] == "detection"]

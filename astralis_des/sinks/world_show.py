@@ -48,8 +48,8 @@ def show_world(world_file: str | Path, messiness: Sequence[float], out: str | Pa
         rec = rr.RecordingStream("astralis_des", recording_id=f"world-{world.name}-{seed}")
         rec.save(folder / out.name, default_blueprint=_overview(world))
         log_solids(rr, rec, world)
-        log_rooms(rr, rec, world, {rid: RoomState(0.0, values[rid], "minimal") for rid in ids})
-        log_furniture(rr, rec, placed, world)
+        log_rooms(rec, world, {rid: RoomState(0.0, values[rid], "minimal") for rid in ids}, None)
+        log_furniture(rec, placed, world)
         close_and_check(rec, folder / out.name)
     return Shown(out, len(ids), Counter(p.kind for p in placed), scene.skipped())
 
