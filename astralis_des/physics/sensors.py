@@ -37,9 +37,11 @@ _DOWN = np.array([0.0, 0.0, -GRAVITY])  # gravity's acceleration: an IMU at rest
 
 
 def _body_pose(client: PhysicsClient, body: int) -> tuple[FloatArray, FloatArray]:
-    """Position and rotation matrix (world from body) of a body's base."""
-    pos, quat = client.call("getBasePositionAndOrientation", body)
-    return np.array(pos), np.array(client.call("getMatrixFromQuaternion", quat)).reshape(3, 3)
+    """Position and rotation matrix (world from body) of a body's base (pybullet at first
+    hand: an IMU asks it 20 times a second)."""
+    pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client.id)
+    rotation = pb.getMatrixFromQuaternion(quat, physicsClientId=client.id)
+    return np.array(pos), np.array(rotation).reshape(3, 3)
 
 
 def _need_rng(noise: float, rng: np.random.Generator | None, what: str) -> None:
@@ -271,10 +273,8 @@ class Imu:
 
     def read(self, dt: float, time: float = 0.0) -> ImuReading:
         """A reading ``dt`` seconds after the previous one (the first assumes no acceleration)."""
-        cid, body = self.client.id, self.body  # pybullet at first hand: read at 20 Hz a robot
-        quat = pb.getBasePositionAndOrientation(body, physicsClientId=cid)[1]
-        rotation = np.array(pb.getMatrixFromQuaternion(quat, physicsClientId=cid)).reshape(3, 3)
-        velocity = pb.getBaseVelocity(body, physicsClientId=cid)
+        _, rotation = _body_pose(self.client, self.body)
+        velocity = pb.getBaseVelocity(self.body, physicsClientId=self.client.id)
         linear, angular = np.array(velocity[0]), np.array(velocity[1])
         previous = linear if self._velocity is None else self._velocity
         self._velocity = linear
