@@ -23,6 +23,7 @@ import os
 import shutil
 import stat
 import sys
+import threading
 import time
 from collections.abc import Collection, Iterator
 from contextlib import contextmanager
@@ -161,13 +162,15 @@ def _tagged(value: Any) -> Any:
     return value
 
 
-def write_file(path: Path, text: str) -> None:
+def write_file(path: Path, text: str, *, sync: bool = True) -> None:
     """Write ``text`` to ``path`` whole: to disk (``fsync``), so that a full disk or an I/O
-    error is an ``OSError`` here and not a short file later."""
+    error is an ``OSError`` here and not a short file later (``sync=False``: a staged file,
+    which :meth:`Staging.settle` puts on disk)."""
     with path.open("w", encoding="utf-8") as f:
         f.write(text)
-        f.flush()
-        os.fsync(f.fileno())
+        if sync:
+            f.flush()
+            os.fsync(f.fileno())
 
 
 def sync(path: Path) -> None:
@@ -177,6 +180,29 @@ def sync(path: Path) -> None:
         os.fsync(fd)
     finally:
         os.close(fd)
+
+
+class _Sync(threading.Thread):
+    """:func:`sync` of one file on a thread of its own (``fsync`` lets go of the GIL): the
+    disk's wait overlaps the writer's work; :meth:`wait` raises its ``OSError``, if any. A
+    plain thread, not a pool's: a process forked meanwhile inherits no idle pool."""
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(name=f"sync {path.name}", daemon=True)
+        self.path = path
+        self.error: OSError | None = None
+        self.start()
+
+    def run(self) -> None:
+        try:
+            sync(self.path)
+        except OSError as exc:
+            self.error = exc
+
+    def wait(self) -> None:
+        self.join()
+        if self.error is not None:
+            raise self.error
 
 
 # -- what a result is made of ----------------------------------------------------------------
@@ -363,6 +389,7 @@ class Staging:
         self.reuse = reuse
         self.folder = self.full.parent / f".{name}.partial"
         self._lock: _Lock | None = None
+        self._syncing: dict[Path, _Sync] = {}  # staged files already being put on disk
 
     def open(self) -> Path:
         """Lock the target and make the staging folder; return it."""
@@ -386,9 +413,24 @@ class Staging:
         with Deferral() as shield, checked(self.target):
             shield.hold()
             try:
+                try:  # what the cache holds fails here, before anything moves
+                    _sync_tree(self.folder, self._syncing)
+                except BaseException:
+                    if not self.reuse:  # nothing moved, nothing is left (a tune's journal
+                        _remove(self.folder)  # stays, to resume from)
+                    raise
+                finally:
+                    self._syncing = {}
                 return self._place()
             finally:
                 self._unlock()
+
+    def settle(self, path: Path) -> None:
+        """The staged file ``path`` is whole: start putting it on disk now, on a thread, while
+        the writer goes on with the others. The commit waits for it (and fails, before
+        anything moves, if it could not be written), as it syncs every other staged file."""
+        if path not in self._syncing:
+            self._syncing[path] = _Sync(path)
 
     def abandon(self) -> None:
         """Remove what was staged: nothing half-written is left (once: the lock is let go)."""
@@ -417,7 +459,6 @@ class Staging:
             _release(lock)
 
     def _place(self) -> list[Path]:
-        _sync_tree(self.folder)  # what the cache holds fails here, before anything moves
         place = self.full.parent if self.file else self.full
         if not self.file and not os.path.lexists(self.full):
             os.rename(self.folder, self.full)  # new: in place at once, whole
@@ -443,10 +484,22 @@ class Staging:
         return placed
 
 
-def _sync_tree(folder: Path) -> None:
+def _sync_tree(folder: Path, syncing: dict[Path, _Sync]) -> None:
+    """Every file under ``folder`` on disk: those ``syncing`` already once their threads are
+    done, the others here (the first error is raised once all are done)."""
+    failed: OSError | None = None
     for root, _, files in os.walk(folder):
         for name in files:
-            sync(Path(root) / name)
+            path = Path(root) / name
+            if path not in syncing:
+                sync(path)
+    for thread in syncing.values():
+        try:
+            thread.wait()
+        except OSError as exc:
+            failed = failed or exc
+    if failed is not None:
+        raise failed
 
 
 def _remove(path: Path) -> None:

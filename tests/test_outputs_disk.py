@@ -197,6 +197,33 @@ def test_an_io_error_mid_run_is_one_line_and_leaves_nothing(
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("name", ["events.jsonl", "summary.json", "recording.rrd"])
+def test_an_io_error_putting_a_file_on_disk_is_one_line_and_leaves_nothing(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+        name: str) -> None:
+    """EIO when a finished file is put on disk (``fsync``, which runs on a thread of its own
+    while the other files are written): exit 74, one line naming the run's folder, and no
+    result in place, whichever file it is."""
+    from astralis_des import outdir
+
+    sync = outdir.sync
+    synced: list[str] = []
+
+    def failing(path: Path) -> None:
+        synced.append(path.name)
+        if path.name == name:
+            raise OSError(errno.EIO, os.strerror(errno.EIO), str(path))
+        sync(path)
+
+    monkeypatch.setattr(outdir, "sync", failing)
+    code = main(["run", str(MISSION), "--out", str(tmp_path / "run"), "--quiet"])
+    assert code == EXIT_OUTPUT
+    line = one_line(capsys.readouterr().err)
+    assert "input/output error" in line and str(tmp_path / "run") in line
+    assert sorted(synced) == ["events.jsonl", "recording.rrd", "summary.json"]
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_recording_that_does_not_read_back_is_an_error(tmp_path: Path) -> None:
     """Rerun's file sink logs a failed write and goes on: the recording is read back."""
     from astralis_des import Simulation, load_mission

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any
 
 from astralis_des.kernel.events import Record, plain
@@ -23,6 +23,11 @@ class RobotStats:
     tasks_cancelled: int
     tasks_preempted: int
     faulted: bool
+
+
+# what summary.json leaves out: the events (events.jsonl has them) and what the wall clock
+# measured (so that the file is reproducible)
+UNSUMMED = frozenset({"events", "wall_time", "sensor_time", "allocation_time"})
 
 
 @dataclass(frozen=True)
@@ -64,14 +69,12 @@ class RunResult:
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready summary; wall time is left out so that the file is reproducible."""
-        data = asdict(replace(self, events=[]))  # not a deep copy of every event
-        data.pop("events")
-        data.pop("wall_time")
-        data.pop("sensor_time")
-        data.pop("allocation_time")
+        data = {f.name: getattr(self, f.name) for f in fields(self) if f.name not in UNSUMMED}
+        data["robots"] = {rid: {f.name: getattr(stats, f.name) for f in fields(stats)}
+                          for rid, stats in self.robots.items()}
         if data["fork"] is None:  # a run that did not fork: its summary as before forks
             data.pop("fork")
-        summary: dict[str, Any] = plain(data)
+        summary: dict[str, Any] = plain(data)  # plain copies: no dataclass is left inside
         return summary
 
 

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import contextlib
-import os
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
@@ -24,6 +23,8 @@ OUTPUT_FILES = result_files("events.jsonl", "summary.json", "recording.rrd", "ru
 
 
 class Output(Protocol):
+    path: Path  # the file it writes (in the staging folder)
+
     def on_event(self, record: Record) -> None: ...
     def close(self, result: RunResult) -> None: ...
     def discard(self) -> None: ...  # the run's outputs are abandoned: let go of the file
@@ -64,6 +65,8 @@ class Outputs:
                 raise self.failed
             for out in self.outputs:
                 out.close(result)
+                if self.stage is not None:  # on disk while the others are written
+                    self.stage.settle(out.path)
         except OSError as exc:
             self._abandon()
             raise self._failure(exc) from exc
@@ -91,15 +94,14 @@ class JsonlWriter:
     folder, :func:`~astralis_des.outdir.staging_path`, until the run ends)."""
 
     def __init__(self, path: Path) -> None:
+        self.path = path
         self._file = path.open("w", encoding="utf-8", buffering=1)
 
     def on_event(self, record: Record) -> None:
         self._file.write(dumps(record) + "\n")
 
     def close(self, result: RunResult) -> None:
-        self._file.flush()
-        os.fsync(self._file.fileno())
-        self._file.close()
+        self._file.close()  # on disk by the staging (Outputs.close settles it)
 
     def discard(self) -> None:
         with contextlib.suppress(OSError):  # its bytes could not be written: no matter now
@@ -114,7 +116,7 @@ class SummaryWriter:
         pass
 
     def close(self, result: RunResult) -> None:
-        write_file(self.path, strict_dumps(result.summary(), indent=2) + "\n")
+        write_file(self.path, strict_dumps(result.summary(), indent=2) + "\n", sync=False)
 
     def discard(self) -> None:
         pass
