@@ -263,8 +263,9 @@ class PhysicsSpec(Strict):
     stuck_timeout: PositiveFloat = Field(15.0, description="s without progress: the action fails")
     solver_iterations: Annotated[int, Field(ge=1, le=200)] = 20
     sleep_idle: bool = Field(
-        False, description="an idle UGV sleeps in Bullet once settled, woken by a command or a "
-        "touch: big teams step several times faster; trajectories differ by millimetres")
+        True, description="an idle UGV sleeps in Bullet once settled, woken by a command or a "
+        "touch: a standing Husky costs Bullet nothing (false: it is stepped as if it drove; "
+        "trajectories differ by millimetres)")
     uav: HexacopterSpec = Field(default_factory=HexacopterSpec)
 
     @model_validator(mode="after")

@@ -17,9 +17,9 @@ Measured in one run, on this machine:
   Python does by default) and, where PYTHONDONTWRITEBYTECODE is set, compiled each time;
 - a team-size curve (``--teams 4 8 16 32 64 100``): the default mission with half the team
   UAVs and half UGVs, in physics with the default sensors and no outputs, idle UGVs asleep
-  in Bullet (``physics.sleep_idle``; ``--awake`` keeps them awake, as the shipped missions
-  do): real-time factor, its share of raw PyBullet's, time inside ``stepSimulation`` and the
-  overhead ratio per team size (goals: >= 10x with 32 robots, >= 3x with 100).
+  in Bullet (``physics.sleep_idle``, the default; ``--awake`` keeps them awake): real-time
+  factor, its share of raw PyBullet's, time inside ``stepSimulation`` and the overhead ratio
+  per team size (goals: >= 10x with 32 robots, >= 3x with 100).
 
 Goals (issue 43): >= 40x real time in the run with the default sensors; wall / time inside
 ``stepSimulation`` <= 1.4 leaving the sensors out; the whole ``astralis run`` process >= 25x.
@@ -183,9 +183,7 @@ def team(size: int) -> list[dict[str, object]]:
 
 def team_curve(mission, sizes: list[int], raw_rate: float,  # type: ignore[no-untyped-def]
                sleep: bool) -> None:
-    physics = mission.spec.physics.model_dump()
-    if sleep:  # only then: the curve runs on code without the option too (--awake)
-        physics["sleep_idle"] = True
+    physics = {**mission.spec.physics.model_dump(), "sleep_idle": sleep}
     print("team-size curve: the default mission with n robots (half UAVs, half UGVs), physics, "
           f"default sensors, no outputs, idle UGVs {'asleep' if sleep else 'awake'} in Bullet:")
     print("  robots  simulated      wall  real-time  of raw  in stepSimulation  overhead  outcome")
