@@ -105,8 +105,10 @@ def build(points: FloatArray, speed: float, accel: float | None = None,
     v = [float(speed)] * (n + 1)
     if accel is not None:
         v[0] = v[-1] = 0.0
+        # each corner's dot product: the same products, summed in the same order as ``@``
+        dots = (legs[:-1] * legs[1:]).sum(axis=1).tolist()
         for i in range(1, n):
-            cos = float(legs[i - 1] @ legs[i]) / (length[i - 1] * length[i])
+            cos = dots[i - 1] / (length[i - 1] * length[i])
             v[i] = speed * max((1 + cos) / 2, MIN_CORNER)
         _limit(v, length, accel)
     if turn_rate is not None:
