@@ -144,13 +144,17 @@ class VoxelMap(_FieldGrid):
         flat = []
         for first, stop in zip(*self.blocks, strict=True):
             first = np.maximum(first, (0, 0, k0))
-            if np.all(stop > first):
-                grid = np.meshgrid(*(np.arange(a, b) for a, b in zip(first, stop, strict=True)),
-                                   indexing="ij")
-                flat.append(np.ravel_multi_index(tuple(g.ravel() for g in grid), shape))
+            if np.all(stop > first):  # the box's cells' flat indices, as ravel_multi_index's
+                x, y, z = (np.arange(a, b) for a, b in zip(first, stop, strict=True))
+                flat.append(((x[:, None, None] * shape[1] + y[None, :, None]) * shape[2]
+                             + z[None, None, :]).ravel())
         if not flat:
             return np.zeros((0, 3), dtype=np.intp)
-        return np.column_stack(np.unravel_index(np.unique(np.concatenate(flat)), shape))
+        cells = np.sort(np.concatenate(flat))  # each once, in order: np.unique's values, by
+        once = np.empty(len(cells), dtype=bool)  # a sort (its hash table is slower here)
+        once[0] = True
+        np.not_equal(cells[1:], cells[:-1], out=once[1:])
+        return np.column_stack(np.unravel_index(cells[once], shape))
 
     @cached_property
     def _field(self) -> _Field | LayerField:
