@@ -142,7 +142,7 @@ def test_an_observation_kept_stays_as_it_was() -> None:
     env.reset(seed=3)
     rng = np.random.default_rng(3)
     kept = []
-    for agent in env.agent_iter():
+    for _ in env.agent_iter():
         obs, _, term, trunc, _ = env.last()
         kept.append((obs, {k: v.copy() for k, v in obs["observation"].items()}))
         env.step(None if term or trunc else random_policy(obs, rng))
