@@ -250,3 +250,16 @@ def test_the_heuristic_policy_follows_each_episode(tmp_path: Path) -> None:
         ran = (tmp_path / f"run{seed}" / "events.jsonl").read_bytes()
         assert (tmp_path / "env" / f"episode_{episode:04d}" / "events.jsonl").read_bytes() == ran
     env.close()
+
+
+def test_the_random_policy_draws_what_rng_choice_draws() -> None:
+    """The same actions from the same generator as ``rng.choice`` of the allowed, one to many,
+    and the generator left in the same state (an experiment's draws stay the same)."""
+    ours, theirs = np.random.default_rng(5), np.random.default_rng(5)
+    for n in [1, 2, 3, 7, 40, 129] * 50:
+        mask = np.zeros(129, dtype=np.int8)
+        mask[np.random.default_rng(n).choice(129, n, replace=False)] = 1
+        assert random_policy({"action_mask": mask}, ours) == int(
+            theirs.choice(np.flatnonzero(mask)))
+    assert ours.integers(2**62) == theirs.integers(2**62)
+    assert random_policy({"action_mask": np.zeros(129, dtype=np.int8)}, ours) == CONTINUE

@@ -134,3 +134,19 @@ def test_a_mask_handed_out_is_the_callers_own() -> None:
     assert env.observe("uav1")["action_mask"][1] == 1  # wait
     env.step(1)
     assert "refused" not in env.infos["uav1"]
+
+
+def test_an_observation_kept_stays_as_it_was() -> None:
+    """The tables are updated in place: what a learner kept from earlier turns is not."""
+    env = MissionEnv(DEFAULT)
+    env.reset(seed=3)
+    rng = np.random.default_rng(3)
+    kept = []
+    for _ in env.agent_iter():
+        obs, _, term, trunc, _ = env.last()
+        kept.append((obs, {k: v.copy() for k, v in obs["observation"].items()}))
+        env.step(None if term or trunc else random_policy(obs, rng))
+    assert len(kept) > 5
+    for obs, copy in kept:
+        for key, value in copy.items():
+            assert obs["observation"][key].tobytes() == value.tobytes(), key

@@ -56,24 +56,28 @@ def state_space(n_agents: int, n_rooms: int) -> spaces.Box:
 
 
 class Observer:
-    """Builds observations; what all agents share is built once per decision time, from
-    tables of what does not change in an episode (kinds, the rooms' places and areas)."""
+    """Builds observations from tables kept for the episode: a decision time writes the
+    robots' rows and those of the rooms that changed (kinds, the rooms' places and areas are
+    written once); what all agents share is handed out as copies made once per decision
+    time, so an observation a learner keeps stays as it was."""
 
     def __init__(self, run: EpisodeRun) -> None:
         self.run = run
         sim = run.sim
         rooms = run.layout.rooms
-        self._static = np.zeros((len(rooms), ROOM_COLUMNS), dtype=np.float32)
+        self._room_table = np.zeros((len(rooms), ROOM_COLUMNS), dtype=np.float32)
         for j, rid in enumerate(rooms):
             room = sim.world.rooms[rid]
-            self._static[j, 8:11] = room.center
-            self._static[j, 11] = room.area
-        self._kinds = np.zeros((len(run.order), AGENT_COLUMNS), dtype=np.float32)
+            self._room_table[j, 8:11] = room.center
+            self._room_table[j, 11] = room.area
+        self._room_rows: list[tuple[Any, ...] | None] = [None] * len(rooms)
+        self._room_states = [(rid, sim.rooms[rid]) for rid in rooms]
+        self._agent_table = np.zeros((len(run.order), AGENT_COLUMNS), dtype=np.float32)
         for i, rid in enumerate(run.order):
-            self._kinds[i, KINDS.index(sim.robots[rid].kind)] = 1.0
+            self._agent_table[i, KINDS.index(sim.robots[rid].kind)] = 1.0
+        self._team = [(rid, sim.robots[rid], sim.handler(rid)) for rid in run.order]
         self._me = {rid: np.eye(len(run.order), dtype=np.float32)[i]
                     for i, rid in enumerate(run.order)}
-        self._rows = np.arange(len(rooms))
         self._key: tuple[Any, ...] | None = None
         self._shared: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
@@ -83,59 +87,65 @@ class Observer:
         key = (run.sim.env.now, len(run.sim.log.records), tuple(run.asked))
         if self._key == key and self._shared is not None:
             return self._shared
+        self._update_agents()
+        self._update_rooms()
         self._key, self._shared = key, (np.array([run.sim.env.now], dtype=np.float32),
-                                        self._agents(), self._rooms())
+                                        self._agent_table.copy(), self._room_table.copy())
         return self._shared
 
-    def _agents(self) -> np.ndarray:
-        run, sim = self.run, self.run.sim
-        now, index = sim.env.now, run.layout.room_index
+    def _update_agents(self) -> None:
+        run = self.run
+        now, index, holds, asked = run.sim.env.now, run.layout.room_index, run.holds, run.asked
         rows = []
-        for rid in run.order:
-            robot = sim.robots[rid]
-            hold = run.holds.get(rid)
-            task = sim.handler(rid).current
-            room = index.get(task.room, -1) + 1 if task is not None and task.room else 0
-            action = TASK_CODES[task.action] if task is not None and task.action in SEARCHES \
-                else 0
-            rows.append((*robot.position(now).tolist(), robot.heading, not run.idle(rid),
-                         robot.faulted, hold is not None and not hold.processed,
-                         rid in run.asked, room, action))
-        out = self._kinds.copy()
-        out[:, 3:] = rows
-        return out
+        for rid, robot, handler in self._team:  # where they are: every row, every time
+            hold = holds.get(rid)
+            task = handler.current
+            if task is None:
+                room = action = 0
+            else:
+                room = index.get(task.room, -1) + 1 if task.room else 0
+                action = TASK_CODES[task.action] if task.action in SEARCHES else 0
+            rows.append((*robot.position(now).tolist(), robot.heading,
+                         task is not None or bool(handler.queued), robot.faulted,
+                         hold is not None and not hold.processed, rid in asked, room, action))
+        self._agent_table[:, 3:] = rows
 
-    def _rooms(self) -> np.ndarray:
-        run, sim = self.run, self.run.sim
-        out = self._static.copy()
-        pending, searched = set(run.pending), set(sim.searched)
-        states, coverage, risk, messiness = [], [], [], []
-        for rid in run.layout.rooms:
-            if rid in run.inflight:
-                states.append(2)
+    def _update_rooms(self) -> None:
+        """The rows whose state, coverage, risk or messiness changed. A value counts as the
+        same only when it is the same object (so a 0.0 that became -0.0 is written too)."""
+        run = self.run
+        inflight, searched, given_up = run.inflight, set(run.sim.searched), run.given_up
+        pending, coverage = set(run.pending), run.coverage
+        table, rows = self._room_table, self._room_rows
+        for j, (rid, state) in enumerate(self._room_states):
+            if rid in inflight:
+                code = 2
             elif rid in searched:
-                states.append(3)
-            elif rid in run.given_up:
-                states.append(4)
+                code = 3
+            elif rid in given_up:
+                code = 4
             else:  # open now (the segment's), or waiting for its segment
-                states.append(1 if rid in pending else 0)
-            coverage.append(run.coverage.get(rid, 0.0))
-            state = sim.rooms[rid]
-            risk.append(state.risk)
-            messiness.append(state.messiness)
-        out[self._rows, states] = 1.0
-        out[:, 5], out[:, 6], out[:, 7] = coverage, risk, messiness
-        return out
+                code = 1 if rid in pending else 0
+            seen, risk, mess = coverage.get(rid, 0.0), state.risk, state.messiness
+            last = rows[j]
+            if (last is None or last[0] != code or last[1] is not seen or last[2] is not risk
+                    or last[3] is not mess):
+                rows[j] = (code, seen, risk, mess)
+                table[j, :5] = 0.0
+                table[j, code] = 1.0
+                table[j, 5:8] = seen, risk, mess
 
     def observe(self, agent: str) -> dict[str, Any]:
         run = self.run
         time, agents, rooms = self.shared()
         queue = np.zeros((QUEUE, 2), dtype=np.float32)
         handler = run.sim.handler(agent)
-        tasks = ([handler.current] if handler.current is not None else []) + handler.queued
+        tasks = handler.queued
+        if handler.current is not None:
+            tasks = [handler.current, *tasks]
+        index = run.layout.room_index
         for k, task in enumerate(tasks[:QUEUE]):
-            queue[k, 0] = run.layout.room_index.get(task.room or "", -1) + 1
-            queue[k, 1] = TASK_CODES.get(task.action, 0)
+            queue[k] = index.get(task.room or "", -1) + 1, TASK_CODES.get(task.action, 0)
         return {"observation": {"time": time, "me": self._me[agent].copy(), "agents": agents,
                                 "queue": queue, "rooms": rooms},
                 "action_mask": run.mask(agent)}

@@ -19,9 +19,10 @@ from astralis_des.streams import stream
 
 
 def random_policy(observation: dict[str, Any], rng: np.random.Generator) -> int:
-    """A uniformly drawn action among those the mask allows."""
+    """A uniformly drawn action among those the mask allows (the draw ``rng.choice`` makes,
+    without its checks)."""
     allowed = np.flatnonzero(observation["action_mask"])
-    return int(rng.choice(allowed)) if len(allowed) else CONTINUE
+    return int(allowed[rng.integers(len(allowed))]) if len(allowed) else CONTINUE
 
 
 class HeuristicPolicy:

@@ -53,8 +53,6 @@ class EpisodeRun:
         self.choices: dict[str, int] = {}  # answers so far at this decision time
         self._asking = 0  # counts the times asked and answered (masks are built per time)
         self._masks: dict[str, tuple[tuple[int, int, bool], np.ndarray]] = {}
-        self._reach: dict[tuple[str, bytes], dict[str, bool]] = {}  # (kind, where) -> room ->
-        # whether it gets there (the kernel's answer, which depends on nothing else)
         self.segment = ""
         self.pending: list[str] = []  # the segment's rooms not yet searched (or in flight)
         self.inflight: dict[str, tuple[str, simpy.Event]] = {}  # room -> searcher, its search
@@ -139,23 +137,16 @@ class EpisodeRun:
                  ) -> np.ndarray | None:
         """``(free, offered)``: which of the rooms each free agent may take; None when no
         search is in flight and no agent at all may take any (the rooms are settled)."""
-        if self.inflight:
-            return self._allowed(free, offered)
-        allowed = self._allowed(agents, offered)
-        return allowed[[agents.index(r) for r in free]] if allowed.any() else None
+        allowed = self._allowed(free, offered)
+        if self.inflight or allowed.any():
+            return allowed
+        asked = {r.id for r in free}
+        busy = [r for r in agents if r.id not in asked]  # looked at only when no free one may
+        return allowed if self._allowed(busy, offered).any() else None
 
     def _allowed(self, robots: list[Robot], rooms: list[str]) -> np.ndarray:
-        """``Simulation.allowed`` (not tried by the kind, reached from where it stands), the
-        kernel asked once per position: a free robot stands still between decisions."""
-        tried, now = self.sim.tried, self.sim.env.now
-        rows = []
-        for robot in robots:
-            known = self._reach.setdefault((robot.kind, robot.position(now).tobytes()), {})
-            missing = [room for room in rooms if room not in known]
-            if missing:
-                known.update(zip(missing, self.sim.reaches(robot, missing), strict=True))
-            rows.append([robot.kind not in tried.get(room, ()) and known[room] for room in rooms])
-        return np.array(rows, dtype=bool).reshape(len(robots), len(rooms))
+        """``Simulation.allowed``: not tried by the kind, reached from where it stands."""
+        return self.sim.allowed(robots, rooms, self.sim.tried)
 
     def _open(self, free: list[Robot], offered: list[str], allowed: np.ndarray) -> None:
         """Ask the ``free`` agents, who may take the ``allowed`` (``(free, offered)``) of the

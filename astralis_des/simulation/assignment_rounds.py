@@ -3,7 +3,9 @@ the record each round leaves (``rounds`` in the summary, an ``assignment`` event
 
 from __future__ import annotations
 
+import math
 import time
+from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -30,6 +32,7 @@ class AssignmentRounds:
     rooms: dict[str, RoomState]
     rounds: list[dict[str, Any]]
     allocation_time: list[float]
+    _weights: tuple[Any, Weights] | None = None  # the mission's weights, as a round takes them
 
     def assignment_round(self, segment: str, rooms: list[str], robots: list[Robot],
                          exclude: dict[str, set[str]] | None = None) -> Assignment:
@@ -51,14 +54,20 @@ class AssignmentRounds:
                      ) -> tuple[list[Agent], list[RoomInfo], Weights, np.ndarray]:
         """What a round is given: the agents where they stand, the rooms as drawn, the
         mission's weights and who may take which room (reaches it, not ``exclude``d)."""
-        cfg = self.mission.spec.assignment
         exclude = exclude or {}
         agents = [Agent(r.id, r.kind, _xyz(r.position(self.env.now))) for r in robots]
         infos = [RoomInfo(rid, self.world.rooms[rid].center, self.rooms[rid].risk,
                           self.rooms[rid].messiness, self.world.rooms[rid].area)
                  for rid in rooms]
-        weights = Weights(cfg.weights.risk.model_dump(), cfg.weights.messiness.model_dump())
-        return agents, infos, weights, self.allowed(robots, rooms, exclude)
+        return agents, infos, self.round_weights(), self.allowed(robots, rooms, exclude)
+
+    def round_weights(self) -> Weights:
+        """The mission's W1 and W2 by kind, made again only when a fork changed them."""
+        given = self.mission.spec.assignment.weights  # a frozen model: a change is a new one
+        if self._weights is None or self._weights[0] is not given:
+            self._weights = (given, Weights(given.risk.model_dump(),
+                                            given.messiness.model_dump()))
+        return self._weights[1]
 
     def allowed(self, robots: list[Robot], rooms: list[str],
                 exclude: dict[str, set[str]] | None = None) -> np.ndarray:
@@ -76,7 +85,8 @@ class AssignmentRounds:
             "round": len(self.rounds) + 1, "t": self.env.now, "segment": segment,
             "strategy": strategy, "agents": list(plan.agents), "rooms": list(plan.rooms),
             "risk": [i.risk for i in infos], "messiness": [i.messiness for i in infos],
-            "costs": [[c if np.isfinite(c) else None for c in row] for row in plan.costs.tolist()],
+            "costs": [[c if math.isfinite(c) else None for c in row]
+                      for row in plan.costs.tolist()],
             "matching": [{"agent": p.agent, "room": p.room, "cost": p.cost, "action": p.action}
                          for p in plan.pairs],
             "unassigned": list(plan.unassigned),
@@ -90,8 +100,21 @@ class AssignmentRounds:
         """Can this robot's kind get to each room from where it is (stairs, ramps, doors)?"""
         if not room_ids:
             return []
-        here = self.world.on_floor(robot.position(self.env.now))
-        return self.world.router.reachable_rooms(here, room_ids, robot.kind)
+        position = robot.position(self.env.now)
+        known = self._reached.setdefault((robot.kind, position.tobytes()), {})
+        missing = [room for room in room_ids if room not in known]
+        if missing:
+            here = self.world.on_floor(position)
+            known.update(zip(missing, self.world.router.reachable_rooms(here, missing, robot.kind),
+                             strict=True))
+        return [known[room] for room in room_ids]
+
+    @cached_property
+    def _reached(self) -> dict[tuple[str, bytes], dict[str, bool]]:
+        """(kind, where it stands) -> room -> whether it gets there: the world's answer,
+        which depends on nothing else, asked once per place a robot is asked from (a robot
+        free for a round stands still)."""
+        return {}
 
 
 def _xyz(p: np.ndarray) -> tuple[float, float, float]:

@@ -13,6 +13,7 @@ overhead over the kernel running the same decisions itself.
   nothing; ``end s`` is the kernel's part spent ending episodes (the UAVs land). ``reset s``
   (a new run to its first decision) is apart, as the issue measured. ``--cpu`` times this
   process's CPU time instead of the wall's (others benchmarking on the same cores).
+  ``gc s``: Python's garbage collections while stepping (inside the other parts).
 - *overhead*: the mixed heuristic as a policy through the env against ``Simulation.run`` with
   the mixed strategy, the same missions (the env reproduces the run's event log byte for
   byte): wall time of one over the other. Goal (issue 22): at most 1.3x.
@@ -22,6 +23,7 @@ overhead over the kernel running the same decisions itself.
 from __future__ import annotations
 
 import argparse
+import gc
 import sys
 import time
 from collections.abc import Callable
@@ -44,14 +46,23 @@ DEFAULT = ROOT / "missions" / "urban_search.yaml"
 class Clock:
     """Wall seconds by part, while stepping: ``kernel`` (the run between decisions, less the
     env's rounds inside it), ``env_inside`` (the env's rounds: who may take what, asking,
-    committing, booking), ``policy``, ``reset`` and ``end`` (ending runs, in ``kernel``)."""
+    committing, booking), ``policy``, ``reset`` and ``end`` (ending runs, in ``kernel``);
+    ``gc``: the garbage collector's passes, wherever they fell."""
 
     def __init__(self) -> None:
         self.now = time.perf_counter  # or time.process_time (--cpu)
         self.zero()
+        self._gc_start = 0.0
+        gc.callbacks.append(self._collecting)
 
     def zero(self) -> None:
-        self.kernel = self.env_inside = self.policy = self.reset = self.end = 0.0
+        self.kernel = self.env_inside = self.policy = self.reset = self.end = self.gc = 0.0
+
+    def _collecting(self, phase: str, info: dict[str, Any]) -> None:
+        if phase == "start":
+            self._gc_start = self.now()
+        else:
+            self.gc += self.now() - self._gc_start
 
 
 CLOCK = Clock()
@@ -147,14 +158,14 @@ def main() -> None:
     print(f"{'kinematic, default team':34} {'decisions':>9} {'cpu s' if args.cpu else 'wall s':>7} "
           f"{'decisions/s':>11}"
           f"   {'kernel s':>8} {'env s':>6} {'policy s':>8} {'env/kernel':>10}"
-          f" {'kernel-bound':>12} {'end s':>5} {'reset s':>7}")
+          f" {'kernel-bound':>12} {'end s':>5} {'reset s':>7} {'gc s':>5}")
     for label, these in (("random, a new seed each episode", seeds),
                          ("random, one seed again and again", [7] * args.episodes)):
         n, wall, _ = episodes(env, these, "random")
         own = wall - CLOCK.kernel - CLOCK.policy
         print(f"{label:34} {n:9,} {wall:7.2f} {n / wall:11,.0f}   {CLOCK.kernel:8.2f} "
               f"{own:6.2f} {CLOCK.policy:8.2f} {own / CLOCK.kernel:10.3f} "
-              f"{n / CLOCK.kernel:12,.0f} {CLOCK.end:5.2f} {CLOCK.reset:7.2f}")
+              f"{n / CLOCK.kernel:12,.0f} {CLOCK.end:5.2f} {CLOCK.reset:7.2f} {CLOCK.gc:5.2f}")
     mixed = MissionEnv(DEFAULT, label="mixed")
     kernel(seeds)  # both warm: the world's caches hold these missions' rooms
     episodes(mixed, seeds, "mixed")
