@@ -52,8 +52,15 @@ class EventLog:
 
 def plain(value: Any) -> Any:
     """JSON-ready, deterministic: numpy to Python, floats rounded to the micrometre/microsecond."""
-    if value is None or type(value) in AS_IS:  # most values (ids, names, counts) first
+    kind = type(value)  # the plain types by identity first: most values are
+    if kind is float:
+        return round(value, 6)
+    if value is None or kind in AS_IS:
         return value
+    if kind is dict:
+        return {k if type(k) is str else str(k): plain(v) for k, v in value.items()}
+    if kind is list or kind is tuple:
+        return [plain(v) for v in value]
     if isinstance(value, np.ndarray):
         return plain(value.tolist())
     if isinstance(value, np.generic):
