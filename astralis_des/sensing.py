@@ -172,29 +172,34 @@ class GeometricSensor:
         seen = np.zeros(len(cells), dtype=bool)
         lo, hi = np.asarray(room.box.lo), np.asarray(room.box.hi)
         in_room = np.all((pts >= lo) & (pts <= hi), axis=1)
-        later = np.zeros((len(pts), len(cells)), dtype=bool)  # the later passes' pairs
-        for first in range(min(PASSES, len(pts))):
-            rows, todo = np.arange(first, len(pts), PASSES), np.flatnonzero(~seen)
-            if len(todo) == 0:
-                break
-            if first == 0:
-                shown = self._first_pass(view, pts, heads, axes, full, size, room)[:, keep]
-                r, c = np.nonzero(shown)
-                pi, ci = rows[r], c
-            else:
-                if first == 1:  # every later pass's points at once (the cells left after
-                    # the first pass): many small calls cost more than one on a few pairs
-                    after = np.flatnonzero(np.arange(len(pts)) % PASSES)
-                    later[_shown(view, pts, axes, cells, size, after, todo)] = True
-                r, c = np.nonzero(later[rows][:, todo])
-                pi, ci = rows[r], todo[c]
-            if not len(boxes):
-                # An empty room is a convex box: from inside it every cell is in sight.
-                seen[ci[in_room[pi]]] = True
-            left = ~seen[ci]
-            if left.any():
-                self._see(pts, cells, pi[left], ci[left], seen, rooms)
+        rows = np.arange(0, len(pts), PASSES)
+        shown = self._first_pass(view, pts, heads, axes, full, size, room)[:, keep]
+        r, c = np.nonzero(shown)
+        self._judge(pts, cells, rows[r], c, seen, in_room, len(boxes) == 0, rooms)
+        todo = np.flatnonzero(~seen)
+        if len(pts) > 1 and len(todo):
+            # the later passes' points at once, for the cells left after the first pass, in
+            # pass order (so a cell's first sight line is from the earliest pass that shows
+            # it): two calls of the sight test instead of two a pass
+            later = np.zeros((len(pts), len(cells)), dtype=bool)
+            after = np.flatnonzero(np.arange(len(pts)) % PASSES)
+            later[_shown(view, pts, axes, cells, size, after, todo)] = True
+            order = np.concatenate([np.arange(first, len(pts), PASSES)
+                                    for first in range(1, min(PASSES, len(pts)))])
+            r, c = np.nonzero(later[order][:, todo])
+            self._judge(pts, cells, order[r], todo[c], seen, in_room, len(boxes) == 0, rooms)
         return float(seen.mean())
+
+    def _judge(self, pts: FloatArray, cells: FloatArray, pi: np.ndarray, ci: np.ndarray,
+               seen: np.ndarray, in_room: np.ndarray, empty: bool,
+               rooms: list[str] | None) -> None:
+        """Mark ``seen`` the cells of the pairs (point ``pi``, cell ``ci``) in sight: from a
+        point inside an ``empty`` room every cell is (a convex box), else by sight lines."""
+        if empty:
+            seen[ci[in_room[pi]]] = True
+        left = ~seen[ci]
+        if left.any():
+            self._see(pts, cells, pi[left], ci[left], seen, rooms)
 
     def _see(self, pts: FloatArray, cells: FloatArray, pi: np.ndarray, ci: np.ndarray,
              seen: np.ndarray, rooms: list[str] | None) -> None:
