@@ -98,9 +98,9 @@ class Occupancy:
         undo = self.stamp(space, box, clearance)
         stamped, taken_before = undo[0][1], undo[0][2]
         radius = passage / 2 / space.cell
-        was = space.free[stamped] & ~taken_before
-        outside = space.open_floor[stamped] & ~space.inside[stamped]
-        if (was & ~outside).all():  # the walk lost the whole rectangle (the usual case)
+        # the walk lost the whole rectangle (the usual case): all of it was free floor (which
+        # lies inside the room) and none of it was taken
+        if space.free[stamped].all() and not taken_before.any():
             walk_eroded = erode_without(self.walk_eroded, radius, stamped)
             if _keeps_reach(space, self.reach, radius, stamped):
                 self.reach = erode_without(self.reach, radius, stamped)
