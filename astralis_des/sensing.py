@@ -121,8 +121,9 @@ class GeometricSensor:
         boxes = self.scene.still_boxes([room.id])
         keep = np.ones(len(full), dtype=bool)
         if len(boxes):
-            keep = ~np.any(np.all((full[:, None, :2] >= boxes[None, :, 0, :2]) &
-                                  (full[:, None, :2] <= boxes[None, :, 1, :2]), axis=2), axis=1)
+            x, y = full[:, 0:1], full[:, 1:2]  # axis by axis: the same cells, fewer calls
+            keep = ~((x >= boxes[None, :, 0, 0]) & (x <= boxes[None, :, 1, 0])
+                     & (y >= boxes[None, :, 0, 1]) & (y <= boxes[None, :, 1, 1])).any(axis=1)
             if not keep.any():
                 return 0.0
         view = robot.view
