@@ -122,8 +122,9 @@ class GeometricSensor:
         keep = np.ones(len(full), dtype=bool)
         if len(boxes):
             x, y = full[:, 0:1], full[:, 1:2]  # axis by axis: the same cells, fewer calls
-            keep = ~((x >= boxes[None, :, 0, 0]) & (x <= boxes[None, :, 1, 0])
-                     & (y >= boxes[None, :, 0, 1]) & (y <= boxes[None, :, 1, 1])).any(axis=1)
+            under = ((x >= boxes[None, :, 0, 0]) & (x <= boxes[None, :, 1, 0])
+                     & (y >= boxes[None, :, 0, 1]) & (y <= boxes[None, :, 1, 1]))
+            keep = ~np.asarray(under.any(axis=1))
             if not keep.any():
                 return 0.0
         view = robot.view
@@ -262,8 +263,13 @@ def _within(world: World, room: Room, pts: FloatArray) -> bool:
     near = np.flatnonzero(np.all((boxes[:, 0] <= pts.max(axis=0)) &
                                  (boxes[:, 1] >= pts.min(axis=0)), axis=1))
     ids = world.room_ids
-    return not any(ids[k] != room.id and np.all((pts >= boxes[k, 0]) & (pts <= boxes[k, 1]),
-                                                axis=1).any() for k in near)
+    others = np.array([ids[k] != room.id for k in near.tolist()], dtype=bool)
+    if not others.any():
+        return True
+    near = near[others]  # the other rooms at once (points x rooms x axes)
+    lo, hi = boxes[near, 0], boxes[near, 1]
+    return not bool(((pts[:, None, :] >= lo[None]) & (pts[:, None, :] <= hi[None]))
+                    .all(axis=2).any())
 
 
 def in_frame(view: View, eyes: FloatArray, headings: FloatArray, centres: FloatArray,

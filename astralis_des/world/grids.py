@@ -8,6 +8,7 @@ whole grid again.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -126,12 +127,16 @@ def disk_grown(radius: float, lost: Cells) -> list[Cells]:
     (i0, i1), (j0, j1) = (lost[0].start, lost[0].stop), (lost[1].start, lost[1].stop)
     if i0 >= i1 or j0 >= j1:
         return []
+    return [(slice(max(i0 - di, 0), i1 + di), slice(max(j0 - h, 0), j1 + h))
+            for di, h in _disk(radius)]
+
+
+@lru_cache(maxsize=256)
+def _disk(radius: float) -> tuple[tuple[int, int], ...]:
+    """A disk of ``radius`` cells as rows ``di`` off its centre and their half widths ``h``."""
     reach = math.floor(radius + 1e-9)
-    out = []
-    for di in range(reach + 1):
-        h = math.floor(math.sqrt(radius * radius - di * di) + 1e-9)
-        out.append((slice(max(i0 - di, 0), i1 + di), slice(max(j0 - h, 0), j1 + h)))
-    return out
+    return tuple((di, math.floor(math.sqrt(radius * radius - di * di) + 1e-9))
+                 for di in range(reach + 1))
 
 
 def reachable(space: FreeSpace, taken: BoolArray, passage: float,

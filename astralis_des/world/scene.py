@@ -295,8 +295,13 @@ class Scene:
         boxes = self.world.room_boxes
         near = np.flatnonzero(np.all((boxes[:, 0] <= ends.max(axis=0)) &
                                      (boxes[:, 1] >= ends.min(axis=0)), axis=1))
-        return [self.world.room_ids[k] for k in near if np.any(np.all(
-            (ends >= boxes[k, 0]) & (ends <= boxes[k, 1]), axis=1))]
+        if len(near) == 0:
+            return []
+        # the near rooms at once (ends x rooms x axes): the same rooms, one call each
+        lo, hi = boxes[near, 0], boxes[near, 1]
+        held = ((ends[:, None, :] >= lo[None]) & (ends[:, None, :] <= hi[None])).all(axis=2)
+        ids = self.world.room_ids
+        return [ids[k] for k in near[held.any(axis=0)].tolist()]
 
 
 def _overlap(a: Box, b: Box) -> bool:
