@@ -348,3 +348,16 @@ def test_cells_near_a_taken_one_kept_up_to_date_are_those_found_afresh(world: Wo
         for grow in (0, 2, 3):
             assert np.array_equal(occupancy.near[grow], afresh.near_taken(grow))
     assert occupancy.taken.any() and not occupancy.taken.all()
+
+
+def test_an_items_size_is_drawn_as_rng_uniform_draws_it() -> None:
+    """An item's size is the very draw ``rng.uniform(size_min, size_max)`` makes, and leaves
+    the generator where it leaves it (furnishing's placements depend on both)."""
+    from astralis_des.world.clutter import _size
+
+    low, high = (0.45, 0.45, 0.8), (0.55, 0.55, 1.0)
+    for seed in range(200):
+        ours, numpys = np.random.default_rng(seed), np.random.default_rng(seed)
+        for _ in range(20):
+            assert _size(ours, low, high) == tuple(numpys.uniform(low, high).tolist())
+        assert ours.random() == numpys.random()
