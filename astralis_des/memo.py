@@ -44,14 +44,16 @@ from typing import Any
 NAMES = frozenset({"voxel_map", "block_field", "free_space", "furnished", "coverage",
                    "floor_cells", "first_pass", "sky", "ducked", "walk_boxes",
                    "occupied_points", "empty_reach", "wall_backs", "routes", "places"})
+_ATTRIBUTES = {name: f"_memo_{name}" for name in NAMES}  # where each is kept on its owner
 
 
 def kept(owner: object, name: str, limit: int | None = None) -> dict[Any, Any]:
     """The cache ``name`` kept on ``owner`` (made empty the first time), emptied when it holds
     ``limit`` entries. ``name`` is one of :data:`NAMES`, each documented above."""
-    if name not in NAMES:
+    attribute = _ATTRIBUTES.get(name)
+    if attribute is None:
         raise KeyError(f"cache {name!r} is not one of astralis_des.memo.NAMES: document it")
-    cache: dict[Any, Any] = owner.__dict__.setdefault(f"_memo_{name}", {})
+    cache: dict[Any, Any] = owner.__dict__.setdefault(attribute, {})
     if limit is not None and len(cache) >= limit:
         cache.clear()
     return cache

@@ -121,8 +121,10 @@ class GeometricSensor:
         boxes = self.scene.still_boxes([room.id])
         keep = np.ones(len(full), dtype=bool)
         if len(boxes):
-            keep = ~np.any(np.all((full[:, None, :2] >= boxes[None, :, 0, :2]) &
-                                  (full[:, None, :2] <= boxes[None, :, 1, :2]), axis=2), axis=1)
+            x, y = full[:, 0:1], full[:, 1:2]  # axis by axis: the same cells, fewer calls
+            under = ((x >= boxes[None, :, 0, 0]) & (x <= boxes[None, :, 1, 0])
+                     & (y >= boxes[None, :, 0, 1]) & (y <= boxes[None, :, 1, 1]))
+            keep = ~np.asarray(under.any(axis=1))
             if not keep.any():
                 return 0.0
         view = robot.view
@@ -172,29 +174,34 @@ class GeometricSensor:
         seen = np.zeros(len(cells), dtype=bool)
         lo, hi = np.asarray(room.box.lo), np.asarray(room.box.hi)
         in_room = np.all((pts >= lo) & (pts <= hi), axis=1)
-        later = np.zeros((len(pts), len(cells)), dtype=bool)  # the later passes' pairs
-        for first in range(min(PASSES, len(pts))):
-            rows, todo = np.arange(first, len(pts), PASSES), np.flatnonzero(~seen)
-            if len(todo) == 0:
-                break
-            if first == 0:
-                shown = self._first_pass(view, pts, heads, axes, full, size, room)[:, keep]
-                r, c = np.nonzero(shown)
-                pi, ci = rows[r], c
-            else:
-                if first == 1:  # every later pass's points at once (the cells left after
-                    # the first pass): many small calls cost more than one on a few pairs
-                    after = np.flatnonzero(np.arange(len(pts)) % PASSES)
-                    later[_shown(view, pts, axes, cells, size, after, todo)] = True
-                r, c = np.nonzero(later[rows][:, todo])
-                pi, ci = rows[r], todo[c]
-            if not len(boxes):
-                # An empty room is a convex box: from inside it every cell is in sight.
-                seen[ci[in_room[pi]]] = True
-            left = ~seen[ci]
-            if left.any():
-                self._see(pts, cells, pi[left], ci[left], seen, rooms)
+        rows = np.arange(0, len(pts), PASSES)
+        shown = self._first_pass(view, pts, heads, axes, full, size, room)[:, keep]
+        r, c = np.nonzero(shown)
+        self._judge(pts, cells, rows[r], c, seen, in_room, len(boxes) == 0, rooms)
+        todo = np.flatnonzero(~seen)
+        if len(pts) > 1 and len(todo):
+            # the later passes' points at once, for the cells left after the first pass, in
+            # pass order (so a cell's first sight line is from the earliest pass that shows
+            # it): two calls of the sight test instead of two a pass
+            later = np.zeros((len(pts), len(cells)), dtype=bool)
+            after = np.flatnonzero(np.arange(len(pts)) % PASSES)
+            later[_shown(view, pts, axes, cells, size, after, todo)] = True
+            order = np.concatenate([np.arange(first, len(pts), PASSES)
+                                    for first in range(1, min(PASSES, len(pts)))])
+            r, c = np.nonzero(later[order][:, todo])
+            self._judge(pts, cells, order[r], todo[c], seen, in_room, len(boxes) == 0, rooms)
         return float(seen.mean())
+
+    def _judge(self, pts: FloatArray, cells: FloatArray, pi: np.ndarray, ci: np.ndarray,
+               seen: np.ndarray, in_room: np.ndarray, empty: bool,
+               rooms: list[str] | None) -> None:
+        """Mark ``seen`` the cells of the pairs (point ``pi``, cell ``ci``) in sight: from a
+        point inside an ``empty`` room every cell is (a convex box), else by sight lines."""
+        if empty:
+            seen[ci[in_room[pi]]] = True
+        left = ~seen[ci]
+        if left.any():
+            self._see(pts, cells, pi[left], ci[left], seen, rooms)
 
     def _see(self, pts: FloatArray, cells: FloatArray, pi: np.ndarray, ci: np.ndarray,
              seen: np.ndarray, rooms: list[str] | None) -> None:
@@ -256,8 +263,13 @@ def _within(world: World, room: Room, pts: FloatArray) -> bool:
     near = np.flatnonzero(np.all((boxes[:, 0] <= pts.max(axis=0)) &
                                  (boxes[:, 1] >= pts.min(axis=0)), axis=1))
     ids = world.room_ids
-    return not any(ids[k] != room.id and np.all((pts >= boxes[k, 0]) & (pts <= boxes[k, 1]),
-                                                axis=1).any() for k in near)
+    others = np.array([ids[k] != room.id for k in near.tolist()], dtype=bool)
+    if not others.any():
+        return True
+    near = near[others]  # the other rooms at once (points x rooms x axes)
+    lo, hi = boxes[near, 0], boxes[near, 1]
+    return not bool(((pts[:, None, :] >= lo[None]) & (pts[:, None, :] <= hi[None]))
+                    .all(axis=2).any())
 
 
 def in_frame(view: View, eyes: FloatArray, headings: FloatArray, centres: FloatArray,

@@ -313,6 +313,19 @@ def test_summed_area_tables_count_the_cells_of_every_window() -> None:
         assert summed(mask)[-1, -1] == mask.sum()
 
 
+def test_cells_near_a_set_one_by_shifts_are_those_a_summed_area_table_finds() -> None:
+    """The cells within a few cells (a square) of a set one, found by shifted copies, are
+    those whose window in a summed-area table of the padded grid holds a set cell."""
+    from astralis_des.world.grids import near, padded, summed, window
+
+    rng = np.random.default_rng(6)
+    for _ in range(60):
+        mask = rng.random((int(rng.integers(1, 25)), int(rng.integers(1, 25)))) > 0.9
+        grow = int(rng.integers(0, 5))
+        table = summed(padded(mask, grow, False))
+        assert np.array_equal(near(mask, grow), window(table, 2 * grow + 1, 2 * grow + 1) > 0)
+
+
 def test_cells_near_a_taken_one_kept_up_to_date_are_those_found_afresh(world: World) -> None:
     """What a footprint's window must avoid (cells within its clearance of a taken one) is
     kept up to date as footprints are stamped: at every step, on random rectangles (at the
@@ -335,3 +348,16 @@ def test_cells_near_a_taken_one_kept_up_to_date_are_those_found_afresh(world: Wo
         for grow in (0, 2, 3):
             assert np.array_equal(occupancy.near[grow], afresh.near_taken(grow))
     assert occupancy.taken.any() and not occupancy.taken.all()
+
+
+def test_an_items_size_is_drawn_as_rng_uniform_draws_it() -> None:
+    """An item's size is the very draw ``rng.uniform(size_min, size_max)`` makes, and leaves
+    the generator where it leaves it (furnishing's placements depend on both)."""
+    from astralis_des.world.clutter import _size
+
+    low, high = (0.45, 0.45, 0.8), (0.55, 0.55, 1.0)
+    for seed in range(200):
+        ours, numpys = np.random.default_rng(seed), np.random.default_rng(seed)
+        for _ in range(20):
+            assert _size(ours, low, high) == tuple(numpys.uniform(low, high).tolist())
+        assert ours.random() == numpys.random()

@@ -142,3 +142,14 @@ def test_a_target_showing_only_its_top_over_furniture_is_seen_in_both_fidelities
     assert view.min_pixels <= rendered < unhidden / 4  # a strip of it, enough to detect
     assert predicted >= view.min_pixels
     assert 0.5 < predicted / rendered < 2.0, (predicted, rendered)
+
+
+def test_all_corners_read_as_words_is_numpys_all() -> None:
+    """Whether all eight corners hold, read a row of eight booleans at a time, is what
+    numpy's ``all`` over them says, on random rows and on empty grids."""
+    from astralis_des.detection import _all_corners
+
+    rng = np.random.default_rng(3)
+    for shape in ((5, 7, 8), (1, 1, 8), (0, 4, 8), (3, 0, 8)):
+        held = rng.random(shape) > 0.1  # most rows all true, some not
+        assert np.array_equal(_all_corners(held), held.all(axis=2))

@@ -8,6 +8,7 @@ whole grid again.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -33,7 +34,25 @@ def window(table: np.ndarray, kx: int, ky: int) -> np.ndarray:
     nx, ny = table.shape[0] - 1, table.shape[1] - 1
     if kx > nx or ky > ny:
         return np.zeros((0, 0), dtype=np.int32)
-    return np.asarray(table[kx:, ky:] - table[:-kx, ky:] - table[kx:, :-ky] + table[:-kx, :-ky])
+    out: np.ndarray = table[kx:, ky:] - table[:-kx, ky:]  # in place from here: no temporaries
+    out -= table[kx:, :-ky]
+    out += table[:-kx, :-ky]
+    return out
+
+
+def near(mask: BoolArray, grow: int) -> BoolArray:
+    """Cells within ``grow`` cells of a set one (a square): the window of ``2 * grow + 1`` cells
+    round each holds one, grown one axis at a time by shifted copies (a few calls for the
+    small squares of clearances, where a summed-area table costs more)."""
+    out = mask.copy()
+    for step in range(1, grow + 1):
+        out[step:] |= mask[:-step]
+        out[:-step] |= mask[step:]
+    rows = out.copy()
+    for step in range(1, grow + 1):
+        out[:, step:] |= rows[:, :-step]
+        out[:, :-step] |= rows[:, step:]
+    return out
 
 
 def padded(mask: BoolArray, width: int, value: bool) -> BoolArray:
@@ -97,14 +116,27 @@ def erode_without(before: BoolArray, radius: float, lost: Cells) -> BoolArray:
     rectangle, i.e. ``before`` less the rectangle grown by the disk (a union of rectangles,
     as in :func:`erode`)."""
     out = before.copy()
+    for cells in disk_grown(radius, lost):
+        out[cells] = False
+    return out
+
+
+def disk_grown(radius: float, lost: Cells) -> list[Cells]:
+    """The rectangle ``lost`` grown by a disk of ``radius`` cells, as the union of rectangles
+    :func:`erode_without` clears (none for an empty one)."""
     (i0, i1), (j0, j1) = (lost[0].start, lost[0].stop), (lost[1].start, lost[1].stop)
     if i0 >= i1 or j0 >= j1:
-        return out
+        return []
+    return [(slice(max(i0 - di, 0), i1 + di), slice(max(j0 - h, 0), j1 + h))
+            for di, h in _disk(radius)]
+
+
+@lru_cache(maxsize=256)
+def _disk(radius: float) -> tuple[tuple[int, int], ...]:
+    """A disk of ``radius`` cells as rows ``di`` off its centre and their half widths ``h``."""
     reach = math.floor(radius + 1e-9)
-    for di in range(reach + 1):
-        h = math.floor(math.sqrt(radius * radius - di * di) + 1e-9)
-        out[max(i0 - di, 0):i1 + di, max(j0 - h, 0):j1 + h] = False
-    return out
+    return tuple((di, math.floor(math.sqrt(radius * radius - di * di) + 1e-9))
+                 for di in range(reach + 1))
 
 
 def reachable(space: FreeSpace, taken: BoolArray, passage: float,

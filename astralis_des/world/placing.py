@@ -20,9 +20,10 @@ from astralis_des.world.freespace import BoolArray, FreeSpace, IntArray
 from astralis_des.world.geometry import Box
 from astralis_des.world.grids import (
     Cells,
+    disk_grown,
     erode,
     erode_near,
-    erode_without,
+    near,
     padded,
     reachable,
     summed,
@@ -30,6 +31,7 @@ from astralis_des.world.grids import (
     window,
 )
 
+SHIFTED = 4  # clearances (cells) up to which the cells near a taken one are found by shifts
 # what a stamp overwrote, to undo it: (array, cells, their values before)
 Undo = list[tuple[BoolArray, Cells, BoolArray]]
 
@@ -66,8 +68,11 @@ class Occupancy:
     def near_taken(self, grow: int) -> BoolArray:
         """Cells within ``grow`` cells (a square) of a taken one."""
         if grow not in self.near:
-            table = summed(padded(self.taken, grow, False))
-            self.near[grow] = window(table, 2 * grow + 1, 2 * grow + 1) > 0
+            if grow <= SHIFTED:
+                self.near[grow] = near(self.taken, grow)
+            else:
+                table = summed(padded(self.taken, grow, False))
+                self.near[grow] = window(table, 2 * grow + 1, 2 * grow + 1) > 0
         return self.near[grow]
 
     def stamp(self, space: FreeSpace, box: Box, clearance: float) -> Undo:
@@ -98,12 +103,17 @@ class Occupancy:
         undo = self.stamp(space, box, clearance)
         stamped, taken_before = undo[0][1], undo[0][2]
         radius = passage / 2 / space.cell
-        was = space.free[stamped] & ~taken_before
-        outside = space.open_floor[stamped] & ~space.inside[stamped]
-        if (was & ~outside).all():  # the walk lost the whole rectangle (the usual case)
-            walk_eroded = erode_without(self.walk_eroded, radius, stamped)
+        # the walk lost the whole rectangle (the usual case): all of it was free floor (which
+        # lies inside the room) and none of it was taken
+        if space.free[stamped].all() and not taken_before.any():
+            cleared = disk_grown(radius, stamped)  # what erode_without clears, once for both
+            walk_eroded = self.walk_eroded.copy()
+            for cells in cleared:
+                walk_eroded[cells] = False
             if _keeps_reach(space, self.reach, radius, stamped):
-                self.reach = erode_without(self.reach, radius, stamped)
+                self.reach = self.reach.copy()
+                for cells in cleared:
+                    self.reach[cells] = False
                 self.walk_eroded = walk_eroded
                 return True
         else:

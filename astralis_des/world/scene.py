@@ -114,6 +114,7 @@ class Scene:
         self._order = {rid: i for i, rid in enumerate(sorted(world.rooms))}
         self._rooms: dict[str, Clutter] = {}
         self._still: dict[str, FloatArray] = {}  # room -> boxes of what stays put in it
+        self._blocking: dict[tuple[str, ...], FloatArray] = {}  # rooms -> what blocks sight
         self._reserved: dict[str, Box] = {}  # room -> the target's footprint, kept free
         self.target: Target | None = None
         self.movers: list[Mover] = self._corridor_movers(movers, mover_speed)
@@ -159,6 +160,7 @@ class Scene:
         """Furnish a room with ``clutter`` (placement, the target's room, tests)."""
         self._rooms[room_id] = clutter
         self._still.pop(room_id, None)
+        self._blocking.clear()
 
     def _clear_target(self, room_id: str, placed: Clutter) -> Clutter:
         keep = self._reserved.get(room_id)
@@ -274,9 +276,16 @@ class Scene:
     def blockers(self, rooms: Iterable[str]) -> FloatArray:
         """Boxes that block sight: walls, slabs, obstacles, and the furniture and avatars that
         stay put in ``rooms`` (the target excluded)."""
-        extra = self.still_boxes(rooms)
-        return np.concatenate([self.world.solid_array, extra]) if len(extra) else \
-            self.world.solid_array
+        key = tuple(rooms)
+        found = self._blocking.get(key)
+        if found is None:  # kept until a room's clutter changes (sight asks again and again)
+            extra = self.still_boxes(key)
+            found = self.world.solid_array
+            if len(extra):
+                found = np.concatenate([found, extra])
+                found.setflags(write=False)
+            self._blocking[key] = found
+        return found
 
     def line_of_sight(self, p0: FloatArray, p1: FloatArray,
                       rooms: list[str] | None = None) -> np.ndarray:
@@ -295,8 +304,13 @@ class Scene:
         boxes = self.world.room_boxes
         near = np.flatnonzero(np.all((boxes[:, 0] <= ends.max(axis=0)) &
                                      (boxes[:, 1] >= ends.min(axis=0)), axis=1))
-        return [self.world.room_ids[k] for k in near if np.any(np.all(
-            (ends >= boxes[k, 0]) & (ends <= boxes[k, 1]), axis=1))]
+        if len(near) == 0:
+            return []
+        # the near rooms at once (ends x rooms x axes): the same rooms, one call each
+        lo, hi = boxes[near, 0], boxes[near, 1]
+        held = ((ends[:, None, :] >= lo[None]) & (ends[:, None, :] <= hi[None])).all(axis=2)
+        ids = self.world.room_ids
+        return [ids[k] for k in near[held.any(axis=0)].tolist()]
 
 
 def _overlap(a: Box, b: Box) -> bool:
