@@ -275,11 +275,9 @@ class Imu:
 
     def read(self, dt: float, time: float = 0.0) -> ImuReading:
         """A reading ``dt`` seconds after the previous one (the first assumes no acceleration).
-        (pybullet at first hand, and one draw of noise: it is read 20 times a second.)"""
-        cid = self.client.id
-        quat = pb.getBasePositionAndOrientation(self.body, physicsClientId=cid)[1]
-        back = np.array(pb.getMatrixFromQuaternion(quat, physicsClientId=cid)).reshape(3, 3).T
-        linear_v, angular_v = pb.getBaseVelocity(self.body, physicsClientId=cid)
+        (One draw of noise for both: it is read 20 times a second.)"""
+        back = _body_pose(self.client, self.body)[1].T
+        linear_v, angular_v = pb.getBaseVelocity(self.body, physicsClientId=self.client.id)
         linear = np.array(linear_v)
         previous = linear if self._velocity is None else self._velocity
         self._velocity = linear
