@@ -91,7 +91,8 @@ class Hexacopter:
         return np.array(pos), rot, np.array(lin), rot.T @ np.array(ang)
 
     def position(self) -> FloatArray:
-        pos, _ = self.client.call("getBasePositionAndOrientation", self.body)
+        """Where it is (pybullet at first hand: read every few control periods)."""
+        pos, _ = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client.id)
         return np.array(pos)
 
     def tilt_deg(self) -> float:
