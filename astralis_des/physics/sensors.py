@@ -270,23 +270,19 @@ class Imu:
         _need_rng(max(self.accel_std, self.gyro_std), self.rng, "Imu")
         self._biases = (np.asarray(self.accel_bias, dtype=float),
                         np.asarray(self.gyro_bias, dtype=float))
-        # both noises in one draw: the same numbers as two draws of three, in that order
-        self._noise = np.repeat([float(self.accel_std), float(self.gyro_std)], 3)
 
     def read(self, dt: float, time: float = 0.0) -> ImuReading:
-        """A reading ``dt`` seconds after the previous one (the first assumes no acceleration).
-        (One draw of noise for both: it is read 20 times a second.)"""
-        back = _body_pose(self.client, self.body)[1].T
-        linear_v, angular_v = pb.getBaseVelocity(self.body, physicsClientId=self.client.id)
-        linear = np.array(linear_v)
+        """A reading ``dt`` seconds after the previous one (the first assumes no acceleration)."""
+        _, rotation = _body_pose(self.client, self.body)
+        velocity = pb.getBaseVelocity(self.body, physicsClientId=self.client.id)
+        linear, angular = np.array(velocity[0]), np.array(velocity[1])
         previous = linear if self._velocity is None else self._velocity
         self._velocity = linear
         accel = (linear - previous) / dt
         accel_bias, gyro_bias = self._biases
-        force = back @ (accel - _DOWN) + accel_bias
-        rate = back @ np.array(angular_v) + gyro_bias
+        force = rotation.T @ (accel - _DOWN) + accel_bias
+        rate = rotation.T @ angular + gyro_bias
         if self.rng is not None:
-            noise = self.rng.normal(0.0, self._noise)
-            force = force + noise[:3]
-            rate = rate + noise[3:]
+            force = force + self.rng.normal(0.0, self.accel_std, 3)
+            rate = rate + self.rng.normal(0.0, self.gyro_std, 3)
         return ImuReading(force, rate, time)
