@@ -64,14 +64,12 @@ def nearest_crossings(lo: FloatArray, hi: FloatArray, centre: FloatArray,
                       stop: float) -> tuple[FloatArray, NDArray[np.intp]]:
     """For each horizontal ray, the nearest box it enters (as :func:`crossings`) and that
     box's row: ``inf`` and -1 where it enters none; of boxes entered at the same distance,
-    the first row. The same numbers as the nearest of :func:`crossings`' columns, from the
-    rays that can meet each box alone: those within the angle its corners span from
-    ``centre`` (every ray, for a box whose footprint holds the centre)."""
+    the first row. :func:`crossings`' own array and nearest, computed only along the rays
+    that can meet each box: those within the angle its corners span from ``centre`` (every
+    ray, for a box whose footprint holds the centre); the others miss it (``inf``) there too."""
     rays = len(directions)
-    best = np.full(rays, np.inf)
-    which = np.full(rays, -1, dtype=np.intp)
     if not len(lo) or not rays:
-        return best, which
+        return np.full(rays, np.inf), np.full(rays, -1, dtype=np.intp)
     x, y = float(centre[0]), float(centre[1])
     angle = np.arctan2(directions[:, 1], directions[:, 0])
     order = np.argsort(angle, kind="stable")
@@ -88,17 +86,16 @@ def nearest_crossings(lo: FloatArray, hi: FloatArray, centre: FloatArray,
     holds = (lo[:, 0] <= x) & (x <= hi[:, 0]) & (lo[:, 1] <= y) & (y <= hi[:, 1])
     begin[holds], end[holds] = 0, rays
     counts = np.minimum(end - begin, rays)
-    box = np.repeat(np.arange(len(lo)), counts)  # box-major: rows ascending for each ray
+    box = np.repeat(np.arange(len(lo)), counts)
     at = np.arange(len(box)) - np.repeat(np.cumsum(counts) - counts, counts)
     ray = np.concatenate([order, order])[np.repeat(begin, counts) + at]
     inv_x, inv_y = _inverse(directions)
-    enter = _enter(lo[box, 0], hi[box, 0], lo[box, 1], hi[box, 1], centre, inv_x[ray],
-                   inv_y[ray], start, stop, False)
-    np.minimum.at(best, ray, enter)
-    won = np.flatnonzero(np.isfinite(enter) & (enter == best[ray]))
-    rays_won, first_won = np.unique(ray[won], return_index=True)
-    which[rays_won] = box[won[first_won]]
-    return best, which
+    enter = np.full((len(lo), rays), np.inf)
+    enter[box, ray] = _enter(lo[box, 0], hi[box, 0], lo[box, 1], hi[box, 1], centre,
+                             inv_x[ray], inv_y[ray], start, stop, False)
+    nearest = np.argmin(enter, axis=0)
+    t = enter[nearest, np.arange(rays)]
+    return t, np.where(np.isfinite(t), nearest, -1)
 
 
 def cut(lo: FloatArray, hi: FloatArray, centre: FloatArray, reach: float) -> NDArray[np.intp]:
