@@ -9,9 +9,9 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
-import pybullet as pb
 
 from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.physics import pb  # imported quietly there (its build time on stderr)
 
 if TYPE_CHECKING:
     import simpy
