@@ -15,7 +15,6 @@ from astralis_des.mission.spec import PhysicsSpec
 from astralis_des.physics.client import GRAVITY, PhysicsClient
 from astralis_des.physics.hexacopter import Hexacopter, write_urdf
 from astralis_des.physics.husky import Husky
-from astralis_des.physics.planar import crossings, nearest_crossings
 from astralis_des.physics.sensors import Camera, Imu, Intrinsics, Lidar2D
 from astralis_des.world.model import World
 
@@ -189,29 +188,6 @@ def test_the_planar_scan_reads_what_bullet_reads(client: PhysicsClient) -> None:
         client.call("removeBody", body)
     assert differ <= beams // 1000
     assert {husky.body, walker} <= seen and len(seen & set(client.static)) >= 4
-
-
-def test_the_nearest_box_of_each_beam_is_the_nearest_of_all_crossings() -> None:
-    """Testing each box only along the beams within its angle gives, bit for bit, the
-    nearest of every box's crossings (ties to the first box): beams turned any way and
-    along the axes, centres outside, inside and on the edge of a box, touching boxes."""
-    rng = np.random.default_rng(11)
-    for case in range(300):
-        lo = rng.uniform(-10.0, 10.0, (40, 3))
-        hi = lo + rng.uniform(0.0, 3.0, (40, 3))
-        hi[::7] = lo[::7] + [0.0, 2.0, 1.0]  # flat boxes
-        lo[1::9, 0] = hi[::9, 0][: len(lo[1::9])]  # boxes that touch
-        heading = [0.0, np.pi / 2, rng.uniform(-np.pi, np.pi)][case % 3]
-        angles = np.linspace(-np.pi, np.pi, 360, endpoint=False) + heading
-        rays = np.column_stack([np.cos(angles), np.sin(angles), np.zeros(360)])
-        centre = [rng.uniform(-12.0, 12.0, 3), (lo[3] + hi[3]) / 2, lo[5]][case % 3]
-        start = [0.5, 0.0][case % 2]
-        every = crossings(lo, hi, centre, rays, start, 30.0)
-        first = np.argmin(every, axis=0)
-        expected = every[first, np.arange(360)]
-        t, row = nearest_crossings(lo, hi, centre, rays, start, 30.0)
-        assert np.array_equal(t, expected)
-        assert np.array_equal(row, np.where(np.isfinite(expected), first, -1))
 
 
 def test_lidar_beams_turn_with_the_heading(client: PhysicsClient) -> None:
