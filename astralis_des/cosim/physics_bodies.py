@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from astralis_des.kinds import KIND_DEFAULTS
+from astralis_des.physics import pb  # imported quietly there (its build time on stderr)
 
 if TYPE_CHECKING:
     import simpy
@@ -136,12 +137,13 @@ class SceneBodies:
         touch, at physics time ``t``."""
         now: set[tuple[str, str]] = set()
         impulses: dict[tuple[str, str], float] = {}
+        names, cid = self.names, self.client.id
         for rid, (robot, _, _) in active.items():
-            body = self.drivers[rid].body
-            for c in self.client.call("getContactPoints", bodyA=body):
-                other = self.names.get(c[2], "object")
-                if (not KIND_DEFAULTS[robot.kind].flies or not robot.airborne) and other in FLOORS \
-                        and c[7][2] > SUPPORT:
+            grounded = not KIND_DEFAULTS[robot.kind].flies or not robot.airborne
+            # pybullet at first hand: a Husky on the ground has a few points at 30 Hz
+            for c in pb.getContactPoints(bodyA=self.drivers[rid].body, physicsClientId=cid):
+                other = names.get(c[2], "object")
+                if grounded and other in FLOORS and c[7][2] > SUPPORT:
                     continue  # wheels or feet on a floor, a UAV taking off or landing
                 key = (rid, other)
                 now.add(key)

@@ -91,7 +91,8 @@ class Hexacopter:
         return np.array(pos), rot, np.array(lin), rot.T @ np.array(ang)
 
     def position(self) -> FloatArray:
-        pos, _ = self.client.call("getBasePositionAndOrientation", self.body)
+        """Where it is (pybullet at first hand: read every few control periods)."""
+        pos, _ = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client.id)
         return np.array(pos)
 
     def tilt_deg(self) -> float:
@@ -130,9 +131,10 @@ class Hexacopter:
         if horizontal > self.max_horizontal:
             k = self.max_horizontal / horizontal
             ax, ay = ax * k, ay * k
-        az = min(max(az, -0.5 * GRAVITY), 0.5 * GRAVITY)
+        az = _clamp(az, -0.5 * GRAVITY, 0.5 * GRAVITY)
         fx, fy, fz = mass * ax, mass * ay, mass * (az + GRAVITY)
-        thrust = max(fx * r02 + fy * r12 + fz * r22, 0.0)
+        thrust = fx * r02 + fy * r12 + fz * r22
+        thrust = 0.0 if thrust < 0.0 else thrust  # max(thrust, 0.0), without the call
         norm = math.sqrt(fx * fx + fy * fy + fz * fz)
         zx, zy, zz = fx / norm, fy / norm, fz / norm
         # desired attitude: body z along the force, heading yaw_ref
@@ -163,7 +165,9 @@ class Hexacopter:
         drag = total = 0.0
         mx = my = mz = 0.0  # sum of thrust x the arm's end, relative to the centre of mass
         for i, (m0, m1, m2, m3, ox, oy, spin) in enumerate(self._geometry):
-            wanted = min(max(m0 * thrust + m1 * w1 + m2 * w2 + m3 * w3, 0.0), ceiling)
+            wanted = m0 * thrust + m1 * w1 + m2 * w2 + m3 * w3
+            wanted = 0.0 if wanted < 0.0 else wanted  # min(max(wanted, 0), ceiling)
+            wanted = ceiling if ceiling < wanted else wanted
             speed = speeds[i]
             speed += (sqrt(wanted / kf) - speed) * alpha
             speeds[i] = speed
@@ -181,3 +185,9 @@ class Hexacopter:
         pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, physicsClientId=cid)
         ex, ey, ez = p_ref[0] - px, p_ref[1] - py, p_ref[2] - pz
         return math.sqrt(ex * ex + ey * ey + ez * ez)
+
+
+def _clamp(value: float, low: float, high: float) -> float:
+    """``min(max(value, low), high)`` to the bit (signed zeros included), without the calls."""
+    value = low if low > value else value
+    return high if high < value else value

@@ -36,8 +36,11 @@ def crossings(lo: FloatArray, hi: FloatArray, centre: FloatArray, directions: Fl
     t_x1 = (hi[:, 0] - x)[:, None] * inv_x
     t_y0 = (lo[:, 1] - y)[:, None] * inv_y
     t_y1 = (hi[:, 1] - y)[:, None] * inv_y
-    enter = np.maximum(np.minimum(t_x0, t_x1), np.minimum(t_y0, t_y1))
-    leave = np.minimum(np.maximum(t_x0, t_x1), np.maximum(t_y0, t_y1))
+    # the same minima and maxima, written over arrays done with (a scan's are boxes x 360)
+    enter = np.minimum(t_x0, t_x1)
+    leave = np.maximum(t_x0, t_x1, out=t_x0)
+    np.maximum(enter, np.minimum(t_y0, t_y1, out=t_x1), out=enter)
+    np.minimum(leave, np.maximum(t_y0, t_y1, out=t_y0), out=leave)
     if inside:
         np.maximum(enter, start, out=enter)
     enter[(enter < start) | (enter > leave) | (enter > stop)] = np.inf

@@ -4,6 +4,7 @@ that it collides with robots and is seen by sensors like any body."""
 from __future__ import annotations
 
 import numpy as np
+import pybullet as pb
 
 from astralis_des.physics.client import PhysicsClient
 from astralis_des.world.geometry import FloatArray
@@ -13,7 +14,8 @@ HEIGHT = 1.2  # between the caps: 1.7 m tall in all
 
 
 class Walker:
-    """A person's capsule, placed (not pushed) where its driver says."""
+    """A person's capsule, placed (not pushed) where its driver says (each control period:
+    pybullet at first hand)."""
 
     centre_height = RADIUS + HEIGHT / 2  # m from the floor to its centre
 
@@ -25,9 +27,9 @@ class Walker:
 
     def place(self, centre: FloatArray, yaw: float = 0.0) -> None:
         """Put it at ``centre`` (a capsule: upright whichever way it faces)."""
-        self.client.call("resetBasePositionAndOrientation", self.body,
-                         [float(v) for v in centre], [0.0, 0.0, 0.0, 1.0])
+        pb.resetBasePositionAndOrientation(self.body, [float(v) for v in centre],
+                                           (0.0, 0.0, 0.0, 1.0), physicsClientId=self.client.id)
 
     def position(self) -> FloatArray:
-        pos, _ = self.client.call("getBasePositionAndOrientation", self.body)
+        pos, _ = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client.id)
         return np.array(pos)
