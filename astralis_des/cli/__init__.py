@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import gc
 import json
 import logging
 import os
@@ -160,9 +159,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         if argv is None:  # the process is ours and its work done: a late signal ends it
             _exit_on_signals()  # at once, without a traceback from an exit handler
-            # and its exit need not look for cycles among all it imported: Python's
-            # finalization collects them, 0.1-0.25 s with Rerun's and SciPy's modules
-            gc.freeze()
         else:  # a caller's (tests): its handlers back
             for sig, handler in before.items():
                 signal.signal(sig, handler)
