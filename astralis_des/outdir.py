@@ -432,12 +432,14 @@ def _sync_tree(folder: Path, syncing: dict[Path, _Sync]) -> None:
     """Every file under ``folder`` on disk: those ``syncing`` already once their threads are
     done, the others here (the first error is raised once all are done)."""
     failed: OSError | None = None
-    for root, _, files in os.walk(folder):
-        for name in files:
-            path = Path(root) / name
-            if path not in syncing:
-                sync(path)
-    for thread in syncing.values():
+    try:
+        for root, _, files in os.walk(folder):
+            for name in files:
+                if Path(root) / name not in syncing:
+                    sync(Path(root) / name)
+    except OSError as exc:
+        failed = exc
+    for thread in syncing.values():  # each done before the folder may be removed
         try:
             thread.wait()
         except OSError as exc:

@@ -83,13 +83,21 @@ def _log_frames(rr: Any, rec: Any, entity: str, frames: list[KeptFrame]) -> None
     index = [rr.TimeColumn(paths.TIMELINE, duration=[f.time for f in frames])]
     rec.send_columns(f"{entity}/rgb", indexes=index, columns=rr.EncodedImage.columns(
         blob=jpegs([f.rgb for f in frames]), media_type=["image/jpeg"] * len(frames)))
-    for name, image, of in (("depth", rr.DepthImage, lambda f: f.depth),
-                            ("segmentation", rr.SegmentationImage, lambda f: f.segmentation)):
-        first = image(of(frames[0]), meter=1000.0) if name == "depth" else image(of(frames[0]))
-        fields = {"meter": [1000.0] * len(frames)} if name == "depth" else {}
-        rec.send_columns(f"{entity}/{name}", indexes=index, columns=image.columns(
-            buffer=[np.ascontiguousarray(of(f)).view(np.uint8).reshape(-1) for f in frames],
-            format=pa.concat_arrays([first.format.as_arrow_array()] * len(frames)), **fields))
+    _send_images(rec, f"{entity}/depth", index, rr.DepthImage, [f.depth for f in frames],
+                 meter=1000.0)
+    _send_images(rec, f"{entity}/segmentation", index, rr.SegmentationImage,
+                 [f.segmentation for f in frames])
+
+
+def _send_images(rec: Any, entity: str, index: list[Any], archetype: Any,
+                 images: list[np.ndarray], **each: float) -> None:
+    """Images of one camera (one size and type) as a column of ``archetype`` at ``index``:
+    each one's buffer, the format of the first, the ``each`` values on every row."""
+    first, n = archetype(images[0], **each), len(images)
+    rec.send_columns(entity, indexes=index, columns=archetype.columns(
+        buffer=[np.ascontiguousarray(image).view(np.uint8).reshape(-1) for image in images],
+        format=pa.concat_arrays([first.format.as_arrow_array()] * n),
+        **{name: [value] * n for name, value in each.items()}))
 
 
 def jpegs(images: Sequence[np.ndarray], quality: int = 85) -> list[bytes]:
