@@ -80,14 +80,19 @@ def colors(values: Any) -> pa.Array:
     return pa.array(packed.astype(np.uint32), pa.uint32())
 
 
+def offsets(lengths: Sequence[int] | np.ndarray) -> pa.Array:
+    """A list array's offsets for lists of ``lengths``: 0, then their running sums."""
+    out = np.zeros(len(lengths) + 1, dtype=np.int32)
+    np.cumsum(lengths, out=out[1:])
+    return pa.array(out, pa.int32())
+
+
 def rows(values: pa.Array, lengths: Sequence[int] | np.ndarray | None = None) -> pa.Array:
     """``values`` as rows: one value a row, or ``lengths`` of them in each."""
     if lengths is None:
-        offsets = np.arange(len(values) + 1, dtype=np.int32)
-    else:
-        offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
-        np.cumsum(lengths, out=offsets[1:])
-    return pa.ListArray.from_arrays(pa.array(offsets, pa.int32()), values)
+        return pa.ListArray.from_arrays(pa.array(np.arange(len(values) + 1, dtype=np.int32),
+                                                 pa.int32()), values)
+    return pa.ListArray.from_arrays(offsets(lengths), values)
 
 
 def one_row(values: pa.Array) -> pa.Array:
@@ -97,11 +102,8 @@ def one_row(values: pa.Array) -> pa.Array:
 
 def strips(points: Sequence[np.ndarray]) -> pa.Array:
     """Line strips (LineStrip3D): each a list of 3-D points, none null."""
-    lengths = [len(p) for p in points]
     flat = vectors(np.vstack(points) if points else np.empty((0, 3)), 3)
-    offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
-    np.cumsum(lengths, out=offsets[1:])
-    return pa.ListArray.from_arrays(pa.array(offsets, pa.int32()), flat,
+    return pa.ListArray.from_arrays(offsets([len(p) for p in points]), flat,
                                     type=pa.list_(pa.field("item", vector_type(3),
                                                            nullable=False)))
 

@@ -19,6 +19,7 @@ from astralis_des.sinks.columns import (
     descriptor,
     flags,
     floats,
+    offsets,
     rows,
     send,
     texts,
@@ -162,13 +163,10 @@ def log_matrices(rec: Any, matrices: Sequence[Matrix]) -> None:
     entity, n = paths.MISSION_MATRIX, len(matrices)
     index = times([m.t for m in matrices])
     heat = [m.heat.ravel() for m in matrices]
-    sizes = np.array([len(h) for h in heat], dtype=np.int32)
-    offsets = np.zeros(n + 1, dtype=np.int32)
-    np.cumsum(sizes, out=offsets[1:])
     nothing = pa.nulls(n, pa.uint8())
     send(rec, f"{entity}/heat", index, {
         descriptor("Image", "buffer"): rows(pa.ListArray.from_arrays(
-            pa.array(offsets, pa.int32()), pa.array(np.concatenate(heat), pa.uint8()),
+            offsets([len(h) for h in heat]), pa.array(np.concatenate(heat), pa.uint8()),
             type=BYTES)),
         descriptor("Image", "format"): rows(pa.StructArray.from_arrays([
             pa.array([m.grid.rooms for m in matrices], pa.uint32()),

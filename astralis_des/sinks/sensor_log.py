@@ -76,11 +76,10 @@ def _log_frames(rr: Any, rec: Any, entity: str, frames: list[KeptFrame]) -> None
     rec.log(entity, rr.Pinhole(focal_length=k.fx, width=k.width, height=k.height,
                                camera_xyz=rr.ViewCoordinates.RDF, image_plane_distance=0.5),
             static=True)
-    rec.send_columns(entity, indexes=[rr.TimeColumn(paths.TIMELINE,
-                                                    duration=[f.time for f in frames])],
+    index = [rr.TimeColumn(paths.TIMELINE, duration=[f.time for f in frames])]
+    rec.send_columns(entity, indexes=index,
                      columns=rr.Transform3D.columns(translation=[f.eye for f in frames],
                                                     mat3x3=[f.rotation for f in frames]))
-    index = [rr.TimeColumn(paths.TIMELINE, duration=[f.time for f in frames])]
     rec.send_columns(f"{entity}/rgb", indexes=index, columns=rr.EncodedImage.columns(
         blob=jpegs([f.rgb for f in frames]), media_type=["image/jpeg"] * len(frames)))
     _send_images(rec, f"{entity}/depth", index, rr.DepthImage, [f.depth for f in frames],
