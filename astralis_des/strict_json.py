@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from typing import Any
 
 
@@ -19,6 +20,19 @@ def dumps(value: Any, **options: Any) -> str:
         if where is None:
             raise
         raise ValueError(f"{where or 'the value'} is not a number JSON can hold") from exc
+
+
+def encoder(**options: Any) -> Callable[[Any], str]:
+    """:func:`dumps` with ``options`` set once (a JSON encoder made once rather than at each
+    call: an event log's lines)."""
+    encode = json.JSONEncoder(allow_nan=False, **options).encode
+
+    def dumps_one(value: Any) -> str:
+        try:
+            return encode(value)
+        except ValueError:
+            return dumps(value, **options)  # raises, naming where the NaN is
+    return dumps_one
 
 
 def _non_finite(value: Any, path: str) -> str | None:

@@ -6,12 +6,13 @@ from __future__ import annotations
 import contextlib
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from astralis_des.kernel.events import Record
 from astralis_des.outdir import Staging, checked, result_files, write_failure, write_file
 from astralis_des.outdir import dumps as strict_dumps
 from astralis_des.simulation.outputs import OUTPUTS
+from astralis_des.strict_json import encoder
 
 if TYPE_CHECKING:
     from astralis_des.simulation import Simulation
@@ -26,7 +27,8 @@ class Output(Protocol):
     path: Path  # the file it writes (in the staging folder)
 
     def on_event(self, record: Record) -> None: ...
-    def close(self, result: RunResult) -> None: ...
+    def close(self, result: RunResult) -> None: ...  # all handed on (may still be written)
+    def finish(self) -> None: ...  # wait until it is written whole (else an OSError)
     def discard(self) -> None: ...  # the run's outputs are abandoned: let go of the file
 
 
@@ -63,9 +65,11 @@ class Outputs:
         try:
             if self.failed is not None:
                 raise self.failed
+            for out in reversed(self.outputs):  # the recording first: Rerun's threads
+                out.close(result)                 # encode it while the others are written
             for out in self.outputs:
-                out.close(result)
-                if self.stage is not None:  # on disk while the others are written
+                out.finish()
+                if self.stage is not None:  # on disk while the others are finished
                     self.stage.settle(out.path)
         except OSError as exc:
             self._abandon()
@@ -103,6 +107,9 @@ class JsonlWriter:
     def close(self, result: RunResult) -> None:
         self._file.close()  # on disk by the staging (Outputs.close settles it)
 
+    def finish(self) -> None:
+        pass
+
     def discard(self) -> None:
         with contextlib.suppress(OSError):  # its bytes could not be written: no matter now
             self._file.close()
@@ -118,12 +125,14 @@ class SummaryWriter:
     def close(self, result: RunResult) -> None:
         write_file(self.path, strict_dumps(result.summary(), indent=2) + "\n", sync=False)
 
+    def finish(self) -> None:
+        pass
+
     def discard(self) -> None:
         pass
 
 
-def dumps(record: Any) -> str:
-    return strict_dumps(record, separators=(",", ":"), ensure_ascii=False)
+dumps = encoder(separators=(",", ":"), ensure_ascii=False)  # an event log's line
 
 
 @OUTPUTS.register("files")

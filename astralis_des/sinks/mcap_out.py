@@ -121,6 +121,9 @@ class McapWriter:
             f.flush()
             os.fsync(f.fileno())  # a full disk fails here, not as a short file later
 
+    def finish(self) -> None:
+        pass
+
     def discard(self) -> None:
         pass
 

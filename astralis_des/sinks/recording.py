@@ -177,7 +177,10 @@ class RerunRecorder:
                         [np.asarray(p, dtype=float).reshape(-1, 3) for _, p in robot.plans]))})
                 send(rec, paths.robot_plan(rid), None, plan)
         self._log_replay(result, perception)
-        close_and_check(rec, self.path)  # Rerun's file sink only logs a failed write
+        rec.flush(timeout_sec=0.0)  # Rerun's threads encode and write it from now on
+
+    def finish(self) -> None:
+        close_and_check(self.rec, self.path)  # Rerun's file sink only logs a failed write
 
     def discard(self) -> None:
         """The run's outputs are abandoned: stop writing (what it wrote is removed)."""
