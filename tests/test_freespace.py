@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from astralis_des.world import freespace
 from astralis_des.world.freespace import (
     boxes_to_mesh,
     cell_centers,
@@ -113,3 +114,19 @@ def test_unknown_room_suggests_a_close_one(world: World) -> None:
     """An unknown room id is refused with a near match."""
     with pytest.raises(KeyError, match=r"unknown room 'A\.1\.1\.9'; did you mean 'A\.1\.1\.3'"):
         room_free_space(world, "A.1.1.9")
+
+
+def test_grid_winding_counts_as_winding_does_on_every_point() -> None:
+    """The grid's winding numbers, judged row by row, are winding()'s for each cell centre:
+    random segments, and segments with their ends on cell centres and edges (the ties)."""
+    rng = np.random.default_rng(7)
+    for trial in range(200):
+        nx, ny = (int(n) for n in rng.integers(1, 50, 2))
+        lo = rng.uniform(-5.0, 5.0, 2).round(1)
+        segments = rng.uniform(-6.0, 12.0, (int(rng.integers(0, 40)), 2, 2))
+        if trial % 2:
+            segments = np.round(segments * 20) / 20
+        xs = lo[0] + (np.arange(nx) + 0.5) * 0.1
+        ys = lo[1] + (np.arange(ny) + 0.5) * 0.1
+        expected = freespace.winding(freespace.cell_centers(lo, (nx, ny), 0.1), segments)
+        assert np.array_equal(freespace.grid_winding(xs, ys, segments), expected), trial

@@ -160,6 +160,31 @@ def winding(points: FloatArray, segments: FloatArray) -> IntArray:
     return np.asarray(upward.sum(axis=1) - downward.sum(axis=1), dtype=np.int64)
 
 
+def grid_winding(xs: np.ndarray, ys: np.ndarray, segments: FloatArray) -> IntArray:
+    """:func:`winding` of the grid points ``(xs[i], ys[j])``, in ``[i, j]`` order: the same
+    numbers, the same sums. A segment counts only for the rows of points its y span takes in
+    (the crossing rule's first test), so each row is judged against the few segments that
+    cross it rather than against all of them."""
+    segments = segments[segments[:, 0, 1] != segments[:, 1, 1]]
+    wind = np.zeros((len(xs), len(ys)), dtype=np.int64)
+    if len(segments) == 0 or len(xs) == 0:
+        return wind.ravel()
+    p, q = segments[:, 0], segments[:, 1]
+    y = ys[:, None]
+    upward = (p[None, :, 1] <= y) & (q[None, :, 1] > y)
+    downward = (q[None, :, 1] <= y) & (p[None, :, 1] > y)
+    row, seg = np.nonzero(upward | downward)  # (row of points, segment) pairs that cross
+    if len(row) == 0:
+        return wind.ravel()
+    p, q, at = p[seg][:, None, :], q[seg][:, None, :], ys[row][:, None]
+    side = (q[..., 0] - p[..., 0]) * (at - p[..., 1]) - \
+        (xs[None, :] - p[..., 0]) * (q[..., 1] - p[..., 1])
+    counts = np.where(upward[row, seg][:, None], side > 0, 0).astype(np.int64) - \
+        np.where(downward[row, seg][:, None], side < 0, 0).astype(np.int64)
+    np.add.at(wind.T, row, counts)
+    return wind.ravel()
+
+
 def segment_cells(segments: FloatArray, bounds_lo: XY, shape: tuple[int, int],
                   cell: float) -> BoolArray:
     """Cells the segments pass through, so thin or open surfaces block too.
@@ -197,8 +222,9 @@ def wall_trace(vertices: FloatArray, faces: IntArray, bounds_lo: XY,
     # The winding rule counts crossings of a ray towards +x: keep what lies on such a ray.
     on_rays = (segments[:, :, 1].max(axis=1) >= lo[1]) & \
         (segments[:, :, 1].min(axis=1) <= hi[1]) & (segments[:, :, 0].max(axis=1) >= lo[0])
-    points = cell_centers(bounds_lo, shape, cell)
-    occupied = (winding(points, segments[on_rays]) != 0).reshape(shape)
+    xs = bounds_lo[0] + (np.arange(shape[0]) + 0.5) * cell  # the cells' centres
+    ys = bounds_lo[1] + (np.arange(shape[1]) + 0.5) * cell  # (as cell_centers makes them)
+    occupied = (grid_winding(xs, ys, segments[on_rays]) != 0).reshape(shape)
     occupied |= segment_cells(_in_bounds(segments, lo, hi), bounds_lo, shape, cell)
     free = ~occupied if floor is None else floor & ~occupied
     blocked = np.pad(~free, 1, constant_values=True)
