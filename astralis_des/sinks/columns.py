@@ -14,7 +14,7 @@ chunk is one with no time column, as ``log(..., static=True)`` makes."""
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from functools import cache
+from functools import cache, lru_cache
 from typing import Any
 
 import numpy as np
@@ -87,17 +87,28 @@ def offsets(lengths: Sequence[int] | np.ndarray) -> pa.Array:
     return pa.array(out, pa.int32())
 
 
+@lru_cache(maxsize=1024)
+def _each_one(n: int) -> pa.Array:
+    """The offsets of ``n`` lists of one value each (Arrow arrays do not change: kept)."""
+    return pa.array(np.arange(n + 1, dtype=np.int32), pa.int32())
+
+
+@lru_cache(maxsize=1024)
+def _all_in_one(n: int) -> pa.Array:
+    """The offsets of one list of ``n`` values."""
+    return pa.array(np.array([0, n], dtype=np.int32), pa.int32())
+
+
 def rows(values: pa.Array, lengths: Sequence[int] | np.ndarray | None = None) -> pa.Array:
     """``values`` as rows: one value a row, or ``lengths`` of them in each."""
     if lengths is None:
-        return pa.ListArray.from_arrays(pa.array(np.arange(len(values) + 1, dtype=np.int32),
-                                                 pa.int32()), values)
+        return pa.ListArray.from_arrays(_each_one(len(values)), values)
     return pa.ListArray.from_arrays(offsets(lengths), values)
 
 
 def one_row(values: pa.Array) -> pa.Array:
     """All of ``values`` in a single row (a static component, a log call's batch)."""
-    return pa.ListArray.from_arrays(pa.array([0, len(values)], pa.int32()), values)
+    return pa.ListArray.from_arrays(_all_in_one(len(values)), values)
 
 
 def strips(points: Sequence[np.ndarray]) -> pa.Array:
