@@ -73,10 +73,13 @@ class AssignmentRounds:
                 exclude: dict[str, set[str]] | None = None) -> np.ndarray:
         """``(robots, rooms)``: who may take which room: it gets there from where it is, and
         its kind is not ``exclude``d from the room (it saw too little of it)."""
-        exclude = exclude or {}
-        return np.array([[robot.kind not in exclude.get(rid, ()) and ok
-                          for rid, ok in zip(rooms, self.reaches(robot, rooms), strict=True)]
-                         for robot in robots], dtype=bool).reshape(len(robots), len(rooms))
+        out = np.array([self.reaches(robot, rooms) for robot in robots],
+                       dtype=bool).reshape(len(robots), len(rooms))
+        for j, kinds in enumerate([exclude.get(rid) for rid in rooms] if exclude else ()):
+            for i, robot in enumerate(robots):
+                if kinds and robot.kind in kinds:
+                    out[i, j] = False
+        return out
 
     def record_round(self, segment: str, strategy: str, plan: Assignment,
                      infos: list[RoomInfo]) -> None:
