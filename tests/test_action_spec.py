@@ -155,5 +155,5 @@ def test_a_task_holds_the_checked_params_whether_kept_or_not() -> None:
         assert str(checked_params("uav", "hover", {"duration": -0.0})[0][1]) == "-0.0"
         assert str(checked_params("uav", "hover", {"duration": 0.0})[0][1]) == "0.0"
         assert checked_params("uav", "spiral_inward", {}) == ()
-        with pytest.raises(ValueError, match="spacing must be at least 0.1"):
+        with pytest.raises(ValueError, match=r"spacing must be at least 0\.1"):
             checked_params("uav", "spiral_inward", {"spacing": 0.01})

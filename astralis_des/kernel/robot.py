@@ -113,7 +113,7 @@ class Motion:
         """Timed vertices passed by time ``t``, plus the pose at ``t``: ``(times, points)``."""
         times = self.t0 + self._course.vertex_times()
         if self._course.in_order:  # those passed are the first k
-            k = int(np.searchsorted(times, t, side="left"))
+            k = int(times.searchsorted(t))
             passed_t, passed_p = times[:k], self.points[:k]
         else:
             keep = times < t
