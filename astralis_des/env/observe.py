@@ -106,7 +106,7 @@ class Observer:
                 room = index.get(task.room, -1) + 1 if task.room else 0
                 action = TASK_CODES[task.action] if task.action in SEARCHES else 0
             rows.append((*robot.position(now).tolist(), robot.heading,
-                         task is not None or bool(handler.queued), robot.faulted,
+                         task is not None or handler.waiting, robot.faulted,
                          hold is not None and not hold.processed, rid in asked, room, action))
         self._agent_table[:, 3:] = rows
 

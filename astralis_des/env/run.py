@@ -130,7 +130,7 @@ class EpisodeRun:
     def idle(self, robot_id: str) -> bool:
         """Whether the robot has nothing running and nothing queued."""
         handler = self.sim.handler(robot_id)
-        return handler.current is None and not handler.queued
+        return handler.current is None and not handler.waiting
 
     def _free(self, robot: Robot) -> bool:
         hold = self.holds.get(robot.id)
@@ -301,7 +301,7 @@ class EpisodeRun:
     def progress(self, refused: dict[str, int] | None = None) -> Progress:
         """What happened since the last call."""
         sim, cfg = self.sim, self.sim.mission.spec.assignment
-        new = sim.finished[self._seen:]
+        new = sim.finished[self._seen:] if self._seen < len(sim.finished) else ()
         self._seen = len(sim.finished)
         risk = clutter = 0.0
         failed: Counter[str] = Counter()
