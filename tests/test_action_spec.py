@@ -140,3 +140,20 @@ def test_the_tables_are_derived_from_the_records() -> None:
     assert hover.help == "hold position and look around (default 10 s)"
     assert robots.VERBS.get(("uav", "search")).variants["outward"] == "spiral_outward"
     assert (robots.ANY_KIND, "move") in robots.VERBS
+
+
+def test_a_task_holds_the_checked_params_whether_kept_or_not() -> None:
+    """A task's params are ``check_params``'s, sorted, also when a plain value's answer is
+    kept: an int is made a float, -0.0 stays itself, and a bad value is refused every time."""
+    from astralis_des.simulation.core import checked_params
+
+    for _ in range(2):
+        assert checked_params("uav", "hover", {"duration": 10}) == (("duration", 10.0),)
+        assert type(checked_params("uav", "hover", {"duration": 10})[0][1]) is float
+        assert checked_params("uav", "move", {"point": "door"}) == tuple(
+            sorted(check_params("uav", "move", {"point": "door"}).items()))
+        assert str(checked_params("uav", "hover", {"duration": -0.0})[0][1]) == "-0.0"
+        assert str(checked_params("uav", "hover", {"duration": 0.0})[0][1]) == "0.0"
+        assert checked_params("uav", "spiral_inward", {}) == ()
+        with pytest.raises(ValueError, match=r"spacing must be at least 0\.1"):
+            checked_params("uav", "spiral_inward", {"spacing": 0.01})

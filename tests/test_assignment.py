@@ -241,3 +241,24 @@ def test_unknown_entry_is_a_lookup_error() -> None:
     """UnknownEntry can be caught as a LookupError."""
     with pytest.raises(LookupError):
         assign(AGENTS, ROOMS, PAPER, strategy="nope")
+
+
+def test_a_rounds_room_is_given_as_it_is_now() -> None:
+    """A round's room carries the room's risk and messiness as they are: kept while they
+    stay, made anew after a room change sets either."""
+    from pathlib import Path
+
+    from astralis_des import Simulation, load_mission
+
+    mission = load_mission(Path(__file__).parents[1] / "missions" / "urban_search.yaml")
+    sim = Simulation(mission)
+    rid = mission.searched_rooms()[0]
+    first = sim.room_info(rid)
+    assert sim.room_info(rid) is first
+    assert (first.risk, first.messiness) == (sim.rooms[rid].risk, sim.rooms[rid].messiness)
+    assert first.position == sim.world.rooms[rid].center
+    sim.rooms[rid].messiness = 0.875  # what a room_change event does
+    changed = sim.room_info(rid)
+    assert (changed.risk, changed.messiness, changed.area) == (first.risk, 0.875, first.area)
+    _, infos, _, _ = sim.round_inputs([rid], [])
+    assert infos == [changed]

@@ -194,6 +194,28 @@ def test_social_metrics_of_a_robot_passing_a_person() -> None:
     assert got["human_close_s"] == pytest.approx(2 * np.sqrt(1.2**2 - 1.0), abs=0.1)
 
 
+def test_the_social_metrics_arithmetic_is_numpys_bit_for_bit() -> None:
+    """The velocities are ``np.gradient``'s and a trail out of time order is sorted stably
+    before it is interpolated, bit for bit, on random paths."""
+    from types import SimpleNamespace
+
+    from astralis_des.simulation.metrics import STEP, _gradient, _track
+
+    rng = np.random.default_rng(11)
+    for n in (2, 3, 7, 500):
+        path = rng.normal(0.0, 5.0, (n, 3))
+        assert _gradient(path).tobytes() == np.gradient(path, STEP, axis=0).tobytes()
+    times = np.arange(0.0, 20.0, STEP)
+    trail_t = [0.0, 4.0, 3.0, 3.0, 9.5, 15.0]
+    trail_p = [rng.normal(0.0, 3.0, 3) for _ in trail_t]
+    robot = SimpleNamespace(trail_t=trail_t, trail_p=trail_p, motion=None, pose=trail_p[-1])
+    order = np.argsort(trail_t, kind="stable")
+    tt, pp = np.asarray(trail_t)[order], np.asarray(trail_p)[order]
+    expected = np.column_stack([np.interp(times, tt, pp[:, k]) for k in range(3)])
+    got = _track(SimpleNamespace(robots={"r": robot}), "r", times, 20.0)  # type: ignore[arg-type]
+    assert got.tobytes() == expected.tobytes()
+
+
 def test_a_run_ended_within_its_first_tenth_of_a_second_has_its_metrics() -> None:
     """A served mission ended at t = 0.01 s (the API's end): its metrics have no closest
     approach to measure, not a traceback in the server's thread (np.gradient of one sample)."""

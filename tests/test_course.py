@@ -70,3 +70,23 @@ def test_what_is_derived_from_a_course_is_kept_by_key() -> None:
     assert second.derived(("x", 0.5), lambda: make(0.5)) == 1.0
     assert second.derived(("x", 0.7), lambda: make(0.7)) == 1.4
     assert made == [0.5, 0.7]
+
+
+def test_the_vertices_passed_are_those_before_the_time_bit_for_bit() -> None:
+    """``vertices_until``: the vertices reached before ``t`` (at their times) and the pose at
+    ``t``, as masking every vertex's time gives them, at any time."""
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        points = rng.normal(0.0, 4.0, (int(rng.integers(1, 8)), 3))
+        if len(points) > 2:
+            points[1] = points[0]
+        motion = Motion(points, 1.5, t0=float(rng.random() * 50), accel=0.8,
+                        turn_rate=1.0 if rng.random() < 0.5 else None)
+        end = motion.t0 + motion.duration
+        for t in [motion.t0 - 1.0, motion.t0, end, end + 1.0,
+                  *(motion.t0 + rng.random(6) * motion.duration)]:
+            times = motion.t0 + motion._course.vertex_times()
+            keep = times < t
+            got_t, got_p = motion.vertices_until(float(t))
+            assert got_t.tolist() == [*times[keep].tolist(), float(t)]
+            assert got_p.tolist() == [*points[keep].tolist(), motion.at(float(t)).tolist()]

@@ -58,6 +58,26 @@ def test_the_log_refuses_an_uncatalogued_kind_or_field() -> None:
     assert log.records == []
 
 
+def test_a_record_holds_plain_values_rounded_to_the_microsecond() -> None:
+    """Times and floats rounded to 6 decimals (the events of one instant too), numpy values
+    made plain, other values as they are."""
+    import numpy as np
+
+    env = simpy.Environment(initial_time=1.23456789)
+    log = EventLog(env)
+    first = log.emit("task_started", "uav1", task=1, action="hover", room=None)
+    second = log.emit("task_finished", "uav1", task=1, action="hover", room="A.1",
+                      status="succeeded", message="", distance=np.float64(2.0000004),
+                      coverage=0.12345651)
+    third = log.emit("landed", "uav1", at=1.5000004, position=np.array([1.0, 2.0000006, 3]))
+    assert first == {"t": 1.234568, "kind": "task_started", "robot": "uav1", "task": 1,
+                     "action": "hover", "room": None}
+    assert second["t"] == 1.234568 and second["distance"] == 2.0
+    assert second["coverage"] == round(0.12345651, 6)
+    assert third["t"] == 1.5 and third["position"] == [1.0, 2.000001, 3.0]
+    assert log.in_order
+
+
 def test_a_failed_task_is_a_warning_and_the_start_is_information() -> None:
     """``task_failed`` had the level WARN but was never emitted: failed tasks showed as DEBUG
     in the replay, and the mission's start too."""

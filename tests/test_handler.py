@@ -270,3 +270,23 @@ def test_cancel_all_at_time_zero() -> None:
     b.env.run()
     assert [t.id for t in hits[0]] == [1]
     assert span(done) == ("cancelled", 0, 0)
+
+
+def test_waiting_says_whether_any_task_is_queued() -> None:
+    """``waiting`` is ``bool(queued)`` at every step: tasks in the queue, one taken but not
+    started yet, one dropped while taken, none."""
+    bench = Bench()
+    handler, env = bench.handler, bench.env
+    seen = []
+    for t in (task(1, 2.0), task(2, 1.0), task(3, 1.0)):
+        handler.submit(t)
+    handler.cancel(3)
+    bench.at(2.5, lambda: (handler.submit(task(4, 1.0)), handler.cancel(4)))
+    bench.at(5.0, lambda: (handler.submit(task(5, 1.0)), handler.cancel(5)))  # taken, dropped
+    bench.at(6.0, lambda: handler.submit(task(6, 1.0)))  # taken, then started
+    while env.peek() != float("inf"):
+        assert handler.waiting == bool(handler.queued)
+        seen.append(handler.waiting)
+        env.step()
+    assert handler.waiting is False and handler.queued == []
+    assert True in seen and False in seen

@@ -106,7 +106,7 @@ class Observer:
                 room = index.get(task.room, -1) + 1 if task.room else 0
                 action = TASK_CODES[task.action] if task.action in SEARCHES else 0
             rows.append((*robot.position(now).tolist(), robot.heading,
-                         task is not None or bool(handler.queued), robot.faulted,
+                         task is not None or handler.waiting, robot.faulted,
                          hold is not None and not hold.processed, rid in asked, room, action))
         self._agent_table[:, 3:] = rows
 
@@ -114,18 +114,15 @@ class Observer:
         """The rows whose state, coverage, risk or messiness changed. A value counts as the
         same only when it is the same object (so a 0.0 that became -0.0 is written too)."""
         run = self.run
-        inflight, searched, given_up = run.inflight, set(run.sim.searched), run.given_up
-        pending, coverage = set(run.pending), run.coverage
-        table, rows = self._room_table, self._room_rows
+        # a room's state: being searched, else searched, else given up, else open now (the
+        # segment's), else waiting for its segment (0): the later ones written over
+        codes = dict.fromkeys(run.pending, 1)
+        codes.update(dict.fromkeys(run.given_up, 4))
+        codes.update(dict.fromkeys(run.sim.searched, 3))
+        codes.update(dict.fromkeys(run.inflight, 2))
+        coverage, table, rows = run.coverage, self._room_table, self._room_rows
         for j, (rid, state) in enumerate(self._room_states):
-            if rid in inflight:
-                code = 2
-            elif rid in searched:
-                code = 3
-            elif rid in given_up:
-                code = 4
-            else:  # open now (the segment's), or waiting for its segment
-                code = 1 if rid in pending else 0
+            code = codes.get(rid, 0)
             seen, risk, mess = coverage.get(rid, 0.0), state.risk, state.messiness
             last = rows[j]
             if (last is None or last[0] != code or last[1] is not seen or last[2] is not risk

@@ -21,7 +21,7 @@ from astralis_des.streams import stream
 def random_policy(observation: dict[str, Any], rng: np.random.Generator) -> int:
     """A uniformly drawn action among those the mask allows (the draw ``rng.choice`` makes,
     without its checks)."""
-    allowed = np.flatnonzero(observation["action_mask"])
+    allowed = np.asarray(observation["action_mask"]).ravel().nonzero()[0]  # flatnonzero
     return int(allowed[rng.integers(len(allowed))]) if len(allowed) else CONTINUE
 
 

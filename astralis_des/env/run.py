@@ -53,6 +53,8 @@ class EpisodeRun:
         self.choices: dict[str, int] = {}  # answers so far at this decision time
         self._asking = 0  # counts the times asked and answered (masks are built per time)
         self._masks: dict[str, tuple[tuple[int, int, bool], np.ndarray]] = {}
+        self._searches = {rid: layout.searches_by(robot.kind).tolist()  # room -> its actions
+                          for rid, robot in self.sim.robots.items()}
         self.segment = ""
         self.pending: list[str] = []  # the segment's rooms not yet searched (or in flight)
         self.inflight: dict[str, tuple[str, simpy.Event]] = {}  # room -> searcher, its search
@@ -106,7 +108,8 @@ class EpisodeRun:
                     yield self._reply
                     self._commit()
                 self._poke = sim.env.event()
-                self.holds = {r: e for r, e in self.holds.items() if not e.processed}
+                if self.holds:
+                    self.holds = {r: e for r, e in self.holds.items() if not e.processed}
                 yield simpy.AnyOf(sim.env, [self._poke, *self.holds.values()])
                 self._book()
         return "not_found"
@@ -127,7 +130,7 @@ class EpisodeRun:
     def idle(self, robot_id: str) -> bool:
         """Whether the robot has nothing running and nothing queued."""
         handler = self.sim.handler(robot_id)
-        return handler.current is None and not handler.queued
+        return handler.current is None and not handler.waiting
 
     def _free(self, robot: Robot) -> bool:
         hold = self.holds.get(robot.id)
@@ -233,8 +236,11 @@ class EpisodeRun:
         else:
             out[WAIT] = out[HOLD] = 1
             taken = {self.layout.decode(c)[1] for c in self.choices.values()}
-            rooms = [self.layout.room_index[r] for r in self.allowed[agent] if r not in taken]
-            out[self.layout.searches_by(self.sim.robots[agent].kind)[rooms]] = 1
+            index, searches = self.layout.room_index, self._searches[agent]
+            for room in self.allowed[agent]:  # a few rooms: item by item beats fancy indexing
+                if room not in taken:
+                    for action in searches[index[room]]:
+                        out[action] = 1
         self._masks[agent] = (key, out)
         return out
 
@@ -295,7 +301,7 @@ class EpisodeRun:
     def progress(self, refused: dict[str, int] | None = None) -> Progress:
         """What happened since the last call."""
         sim, cfg = self.sim, self.sim.mission.spec.assignment
-        new = sim.finished[self._seen:]
+        new = sim.finished[self._seen:] if self._seen < len(sim.finished) else ()
         self._seen = len(sim.finished)
         risk = clutter = 0.0
         failed: Counter[str] = Counter()

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from bisect import bisect_right
 from collections.abc import Callable, Hashable
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import Any, TypeVar
 
 import numpy as np
@@ -80,6 +80,12 @@ class Course:
             times.flags.writeable = False
             self._times = times
         return self._times
+
+    @cached_property
+    def in_order(self) -> bool:
+        """Whether the vertices' times never decrease (then those passed by a time are the
+        first ones)."""
+        return bool(np.all(np.diff(self.vertex_times()) >= 0))
 
     def level_legs(self) -> tuple[list[float], list[int], list[float]]:
         """The legs that move horizontally, in order: where each starts (arc length), its

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import simpy
 
-from astralis_des.kernel.catalogue import EVENTS
+from astralis_des.kernel.catalogue import EVENTS, EventKind
 
 Record = dict[str, Any]
 AS_IS = frozenset({str, int, bool})  # types plain() returns as they are
@@ -25,18 +25,28 @@ class EventLog:
         self.sinks: list[Sink] = []
         self.watchers: list[Sink] = []  # called once every sink has a record (a fork)
         self.in_order = True  # every record's time at or after the one before
+        self._kinds: dict[str, tuple[int, EventKind]] = {}  # kind -> (registry version, it)
+        self._t: tuple[object, float] = (None, 0.0)  # the last time emitted, rounded
 
     def emit(self, kind: str, robot: str | None = None, *, at: float | None = None,
              **payload: Any) -> Record:
         """Record an event now, or ``at`` a time between now and the next pending event (the
         physics stepper's time inside a macro-step). A kind, or a field, the catalogue does
         not declare is refused (``ValueError``, ``LookupError``): a bug, not a record."""
-        EVENTS.get(kind).check(robot, payload)
+        known = self._kinds.get(kind)
+        if known is None or known[0] != EVENTS.version:
+            known = self._kinds[kind] = (EVENTS.version, EVENTS.get(kind))
+        known[1].check(robot, payload)
         t = self.env.now if at is None else at
-        record: Record = {"t": round(float(t), 6), "kind": kind}
+        if t is not self._t[0]:  # the same instant's events share one rounding
+            self._t = (t, round(float(t), 6))
+        record: Record = {"t": self._t[1], "kind": kind}
         if robot is not None:
             record["robot"] = robot
-        record.update({k: plain(v) for k, v in payload.items()})
+        for k, v in payload.items():
+            kind_of = type(v)
+            record[k] = v if v is None or kind_of in AS_IS else (
+                round(v, 6) if kind_of is float else plain(v))
         if self.records and record["t"] < self.records[-1]["t"]:
             self.in_order = False
         self.records.append(record)

@@ -45,6 +45,14 @@ class TaskHandler:
         ahead = [taken] if taken is not None and taken.id not in self._dropped else []
         return ahead + list(self.queue.items)
 
+    @property
+    def waiting(self) -> bool:
+        """Whether any task is waiting (``queued`` is not empty), without listing them."""
+        if self.queue.items:
+            return True
+        taken = self._taken()
+        return taken is not None and taken.id not in self._dropped
+
     def submit(self, task: Task, *, front: bool = False) -> simpy.Event:
         done = self.env.event()
         self._done[task.id] = done

@@ -112,9 +112,17 @@ class Motion:
     def vertices_until(self, t: float) -> tuple[FloatArray, FloatArray]:
         """Timed vertices passed by time ``t``, plus the pose at ``t``: ``(times, points)``."""
         times = self.t0 + self._course.vertex_times()
-        keep = times < t
-        pts = np.vstack([self.points[keep], self.at(t)[None, :]])
-        return np.append(times[keep], t), pts
+        if self._course.in_order:  # those passed are the first k
+            k = int(times.searchsorted(t))
+            passed_t, passed_p = times[:k], self.points[:k]
+        else:
+            keep = times < t
+            passed_t, passed_p = times[keep], self.points[keep]
+        k = len(passed_t)
+        out_t, out_p = np.empty(k + 1), np.empty((k + 1, self.points.shape[1]))
+        out_t[:k], out_t[k] = passed_t, t
+        out_p[:k], out_p[k] = passed_p, self._course.point(self.profile.arc_at(t - self.t0))
+        return out_t, out_p
 
 
 @dataclass

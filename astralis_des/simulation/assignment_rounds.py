@@ -56,10 +56,18 @@ class AssignmentRounds:
         mission's weights and who may take which room (reaches it, not ``exclude``d)."""
         exclude = exclude or {}
         agents = [Agent(r.id, r.kind, _xyz(r.position(self.env.now))) for r in robots]
-        infos = [RoomInfo(rid, self.world.rooms[rid].center, self.rooms[rid].risk,
-                          self.rooms[rid].messiness, self.world.rooms[rid].area)
-                 for rid in rooms]
+        infos = [self.room_info(rid) for rid in rooms]
         return agents, infos, self.round_weights(), self.allowed(robots, rooms, exclude)
+
+    def room_info(self, rid: str) -> RoomInfo:
+        """A room as a round is given it: its centre and area, its risk and messiness as
+        drawn (made again when a room change replaced either)."""
+        state, kept = self.rooms[rid], self._infos.get(rid)
+        if kept is None or kept[0] is not state.risk or kept[1] is not state.messiness:
+            room = self.world.rooms[rid]
+            kept = self._infos[rid] = (state.risk, state.messiness, RoomInfo(
+                rid, room.center, state.risk, state.messiness, room.area))
+        return kept[2]
 
     def round_weights(self) -> Weights:
         """The mission's W1 and W2 by kind, made again only when a fork changed them."""
@@ -73,10 +81,13 @@ class AssignmentRounds:
                 exclude: dict[str, set[str]] | None = None) -> np.ndarray:
         """``(robots, rooms)``: who may take which room: it gets there from where it is, and
         its kind is not ``exclude``d from the room (it saw too little of it)."""
-        exclude = exclude or {}
-        return np.array([[robot.kind not in exclude.get(rid, ()) and ok
-                          for rid, ok in zip(rooms, self.reaches(robot, rooms), strict=True)]
-                         for robot in robots], dtype=bool).reshape(len(robots), len(rooms))
+        out = np.array([self.reaches(robot, rooms) for robot in robots],
+                       dtype=bool).reshape(len(robots), len(rooms))
+        for j, kinds in enumerate([exclude.get(rid) for rid in rooms] if exclude else ()):
+            for i, robot in enumerate(robots):
+                if kinds and robot.kind in kinds:
+                    out[i, j] = False
+        return out
 
     def record_round(self, segment: str, strategy: str, plan: Assignment,
                      infos: list[RoomInfo]) -> None:
@@ -108,6 +119,12 @@ class AssignmentRounds:
             known.update(zip(missing, self.world.router.reachable_rooms(here, missing, robot.kind),
                              strict=True))
         return [known[room] for room in room_ids]
+
+    @cached_property
+    def _infos(self) -> dict[str, tuple[float, float, RoomInfo]]:
+        """room -> (its risk, its messiness, its RoomInfo): the objects ``room_info`` made
+        it from, so that any change makes it anew."""
+        return {}
 
     @cached_property
     def _reached(self) -> dict[tuple[str, bytes], dict[str, bool]]:

@@ -8,6 +8,7 @@ import itertools
 import logging
 import time
 from collections.abc import Callable, Generator
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +45,7 @@ from astralis_des.world.scene import Scene
 
 log = logging.getLogger(__name__)
 Progress = Callable[[float, float], None]
+PLAIN = frozenset({str, int, float, bool})  # parameter values whose check is kept
 WIND_DOWN = frozenset({"found", "not_found", "team_lost"})  # ends after which the UAVs land
 LANDING_LIMIT = 60.0  # s of simulated time the wind-down may take
 # The process that searches the mission's rooms (the timeline's rounds by default; an
@@ -149,9 +151,9 @@ class Simulation(AssignmentRounds):
                 round: int | None = None, preempt: bool = False) -> simpy.Event:
         """Queue a task for a robot; the returned event succeeds with its ActionResult. A
         parameter the action does not take, or a bad value, is a ``ValueError`` (one line)."""
-        checked = check_params(self.robots[robot_id].kind, action, params or {})
-        task = Task(next(self._ids), robot_id, action, room, tuple(sorted(checked.items())),
-                    origin, round)
+        task = Task(next(self._ids), robot_id, action, room,
+                    checked_params(self.robots[robot_id].kind, action, params or {}), origin,
+                    round)
         self.log.emit("task_queued", robot_id, task=task.id, action=action, room=room,
                       origin=origin)
         handler = self._handlers[robot_id]
@@ -349,6 +351,26 @@ class Simulation(AssignmentRounds):
                                           self.env.timeout(LANDING_LIMIT)])
             while not over.triggered:  # an earlier advance(until)'s stop may still be due
                 self.env.run(until=over)
+
+
+def checked_params(kind: str, action: str, params: dict[str, Any]
+                   ) -> tuple[tuple[str, Any], ...]:
+    """``check_params``'s answer as a task holds it (sorted pairs). Plain values (the rounds'
+    door, a hold's duration) are checked once per process and version of the actions'
+    registry: the answer depends on nothing else."""
+    if not params:
+        return ()
+    if all(type(v) in PLAIN for v in params.values()):
+        return _checked(kind, action, tuple((k, type(v), v.hex() if type(v) is float else v)
+                                            for k, v in params.items()), ACTIONS.version)
+    return tuple(sorted(check_params(kind, action, params).items()))
+
+
+@lru_cache(maxsize=1024)
+def _checked(kind: str, action: str, key: tuple[tuple[str, type, Any], ...], version: int
+             ) -> tuple[tuple[str, Any], ...]:
+    params = {k: float.fromhex(v) if t is float else v for k, t, v in key}
+    return tuple(sorted(check_params(kind, action, params).items()))
 
 
 def view_of(member: MemberSpec) -> View | None:

@@ -128,32 +128,40 @@ def social(sim: Run, end: float) -> dict[str, float | None]:
     if not people or not others or len(times) < 2:  # a speed needs two samples
         return {"human_min_distance": None, "human_close_s": None}
     where = {rid: _track(sim, rid, times, end) for rid in sim.robots}
+    moving = {rid: np.linalg.norm(_gradient(where[rid]), axis=1) > MOVING for rid in others}
     nearest, close = np.inf, 0.0
     for person in people:
         near = np.full(len(times), np.inf)
         for rid in others:
-            path = where[rid]
-            speed = np.linalg.norm(np.gradient(path, STEP, axis=0), axis=1)
-            gap = np.linalg.norm(path - where[person], axis=1)
-            near = np.minimum(near, np.where(speed > MOVING, gap, np.inf))
+            gap = np.linalg.norm(where[rid] - where[person], axis=1)
+            near = np.minimum(near, np.where(moving[rid], gap, np.inf))
         nearest = min(nearest, float(near.min()))
         close += float((near < CLOSE).sum() * STEP)
     return {"human_min_distance": nearest if np.isfinite(nearest) else None,
             "human_close_s": close}
 
 
+def _gradient(path: np.ndarray) -> np.ndarray:
+    """``np.gradient(path, STEP, axis=0)`` for two samples or more, the same arithmetic
+    without its generality (central differences inside, one-sided at the ends)."""
+    out = np.empty_like(path)
+    out[1:-1] = (path[2:] - path[:-2]) / (2.0 * STEP)
+    out[0] = (path[1] - path[0]) / STEP
+    out[-1] = (path[-1] - path[-2]) / STEP
+    return out
+
+
 def _track(sim: Run, rid: str, times: np.ndarray, end: float) -> np.ndarray:
     """Where robot ``rid`` was at ``times``, from its trail (and a motion still under way)."""
     robot = sim.robots[rid]
-    t = list(robot.trail_t)
-    p = [np.asarray(q, dtype=float) for q in robot.trail_p]
+    tt = np.array(robot.trail_t, dtype=float)
+    pp = np.array(robot.trail_p, dtype=float).reshape(-1, 3)
     if robot.motion is not None:
         more_t, more_p = robot.motion.vertices_until(end)
-        t += more_t.tolist()
-        p += list(more_p)
-    if not t:
+        tt, pp = np.concatenate([tt, more_t]), np.concatenate([pp, more_p])
+    if not len(tt):
         return np.repeat(np.asarray(robot.pose, dtype=float)[None, :], len(times), axis=0)
-    tt, pp = np.asarray(t), np.asarray(p)
-    order = np.argsort(tt, kind="stable")
-    tt, pp = tt[order], pp[order]
+    if len(tt) > 1 and bool((tt[1:] < tt[:-1]).any()):  # a stable sort changes nothing else
+        order = np.argsort(tt, kind="stable")
+        tt, pp = tt[order], pp[order]
     return np.column_stack([np.interp(times, tt, pp[:, k]) for k in range(3)])
