@@ -19,6 +19,8 @@ What is kept, on what (``kept(owner, NAME)``):
 - on a world's **router**: ``routes`` (waypoints, by ends and kind, read-only) and
   ``places`` (the place of a point);
 - on a **voxel map**: ``occupied_points`` (its occupied cells' centres);
+- on a room's **clutter** (kept on the world, above): ``still_boxes`` (the corners of what
+  stays put in it, read-only);
 - on a room's **free space**: ``empty_reach`` (where a robot reaches in the empty room, by
   passage; the bounds of its door cells) and ``wall_backs`` (where a footprint's back lies
   along a wall, and the windows there, by wall and footprint).
@@ -43,7 +45,8 @@ from typing import Any
 
 NAMES = frozenset({"voxel_map", "block_field", "free_space", "furnished", "coverage",
                    "floor_cells", "first_pass", "sky", "ducked", "walk_boxes",
-                   "occupied_points", "empty_reach", "wall_backs", "routes", "places"})
+                   "occupied_points", "empty_reach", "wall_backs", "routes", "places",
+                   "still_boxes"})
 _ATTRIBUTES = {name: f"_memo_{name}" for name in NAMES}  # where each is kept on its owner
 
 

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from astralis_des.kinds import TARGET_HEIGHT
+from astralis_des.memo import kept
 from astralis_des.streams import stream
 from astralis_des.world import coverage as cov
 from astralis_des.world.catalogue import Catalogue
@@ -195,7 +196,7 @@ class Scene:
         arrays = []
         for rid in room_ids:
             if rid not in self._still:
-                self._still[rid] = boxes_array([p.box for p in self.static_bodies([rid])])
+                self._still[rid] = _still_of(self.clutter(rid))
             arrays.append(self._still[rid])
         return np.concatenate(arrays) if arrays else np.zeros((0, 2, 3))
 
@@ -315,3 +316,16 @@ class Scene:
 
 def _overlap(a: Box, b: Box) -> bool:
     return all(a.lo[k] < b.hi[k] and b.lo[k] < a.hi[k] for k in range(2))
+
+
+def _still_of(clutter: Clutter) -> FloatArray:
+    """The corners of what stays put of ``clutter`` (not the patrolling avatars), kept on it
+    read-only: a room's furniture is drawn once per world, seed and room, and each run's
+    scene asks for its boxes again."""
+    memo = kept(clutter, "still_boxes")
+    if "boxes" not in memo:
+        boxes = boxes_array([p.box for p in clutter.placed
+                             if dict(p.attributes).get("activity") != "patrolling"])
+        boxes.setflags(write=False)
+        memo["boxes"] = boxes
+    return memo["boxes"]
