@@ -8,7 +8,8 @@
   (about 30 ms at 320 x 240), and the target is detected when at least ``min_pixels`` of its
   segmentation show (within range, when the camera has one). The estimate is the centroid
   of those pixels' depth points.
-  Frames are kept for the recording at ``record_rate``, rendered at half resolution.
+  Frames are kept for the recording at ``record_rate``, rendered at half resolution, when
+  the run's outputs record them (``Host.recorded``): a run without a recording renders none.
 - **Lidars** scan at their rate while their robot moves; a UGV slows down for the nearest
   return ahead of it (the local planner's safety bubble).
 - **IMUs** read at their rate while their robot moves.
@@ -94,6 +95,7 @@ class Perception:
 
     def __init__(self, cosim: Engine, sim: Host) -> None:
         self.cosim, self.env = cosim, sim.env
+        self._host = sim  # asked at each look whether its outputs record the kept frames
         self.clock = SensorClock()
         self.frames: list[KeptFrame] = []
         self.scans: list[KeptScan] = []
@@ -172,7 +174,7 @@ class Perception:
 
     def _look(self, robot: Robot, eyes: Eyes, yaws: list[float | None]) -> Sighting | None:
         now = self.env.now
-        if eyes.spec.record_rate > 0 and now >= eyes.next_keep:
+        if eyes.spec.record_rate > 0 and now >= eyes.next_keep and self._host.recorded:
             eyes.next_keep = now + 1.0 / eyes.spec.record_rate
             with self.clock.timed("camera"):
                 self._keep(robot.id, eyes.small.capture(now, yaws[0]), detection=False)
