@@ -33,7 +33,9 @@ class PhysicsClient:
     A body's base pose and velocity (``base_pose``, ``base_velocity``) are read from PyBullet
     once between two changes of the state (a step, or a ``call`` that is not a read): the
     controllers, the checks and the sensors of one tick ask for the same numbers, and each
-    read costs PyBullet a request of the body's whole state.
+    read costs PyBullet a request of the body's whole state. Whatever sets a body's pose or
+    velocity does it through ``call`` (or ``place``), not through ``pybullet`` itself, so
+    that the next read sees it.
     """
 
     def __init__(self, world: World, dt: float, substeps: int, solver_iterations: int) -> None:
