@@ -8,6 +8,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
+import pybullet as pb
 import pytest
 
 from astralis_des.mission.spec import PhysicsSpec
@@ -90,3 +91,28 @@ def test_rotor_speeds_stay_within_their_limit(craft: tuple) -> None:
     client, hexa, spec = craft
     fly(client, hexa, spec, (30.0, 30.0, 30.0), 2.0)
     assert max(hexa.rotor_speed) <= spec.uav.max_rotor_speed + 1e-6
+
+
+def test_pose_and_velocity_read_once_are_what_pybullet_says_after_each_change(
+        craft: tuple) -> None:
+    """The client's pose and velocity reads, kept between changes, equal PyBullet's own after
+    a reset, a velocity set, a step and a walker-style place: never a stale pose."""
+    client, hexa, _ = craft
+
+    def fresh() -> tuple:
+        return (pb.getBasePositionAndOrientation(hexa.body, physicsClientId=client.id),
+                pb.getBaseVelocity(hexa.body, physicsClientId=client.id))
+
+    def kept() -> tuple:
+        return client.base_pose(hexa.body), client.base_velocity(hexa.body)
+
+    assert kept() == fresh()
+    client.call("resetBasePositionAndOrientation", hexa.body, [31.0, 30.0, 2.0], [0, 0, 0, 1])
+    assert kept() == fresh() and kept()[0][0] == (31.0, 30.0, 2.0)
+    client.call("resetBaseVelocity", hexa.body, [0.5, 0.0, 0.0], [0.0, 0.0, 0.1])
+    assert kept() == fresh() and kept()[1][0] == (0.5, 0.0, 0.0)
+    hexa.control(START, STILL)
+    client.step()
+    assert kept() == fresh() and kept()[0][0] != (31.0, 30.0, 2.0)
+    client.place(hexa.body, [32.0, 30.0, 2.0], (0.0, 0.0, 0.0, 1.0))
+    assert kept() == fresh() and kept()[0][0] == (32.0, 30.0, 2.0)

@@ -21,12 +21,13 @@ TARGET = [71.3, 83.0, 0.5]
 
 
 def sim_with(member: dict[str, Any], target: list[float] = TARGET,
-             fidelity: str = "physics") -> Simulation:
-    """A one-robot physics mission in an empty room with the target at ``target``."""
+             fidelity: str = "physics", out_dir: Path | None = None) -> Simulation:
+    """A one-robot physics mission in an empty room with the target at ``target`` (its
+    outputs, the recording among them, in ``out_dir`` if given)."""
     mission = load_mission(MISSIONS / "fig7.yaml").with_changes(
         fidelity=fidelity, team=[member], scene={"clutter": False},
         target={"room": ROOM, "position": target, "avatar": {"activity": "idle"}})
-    sim = Simulation(mission)
+    sim = Simulation(mission, out_dir=out_dir)
     sim.start()
     return sim
 
@@ -72,11 +73,11 @@ def test_a_target_out_of_view_costs_a_frustum_test_not_a_frame() -> None:
     sim.finish()
 
 
-def test_a_hovering_uav_looks_around_and_keeps_the_detection_frame() -> None:
+def test_a_hovering_uav_looks_around_and_keeps_the_detection_frame(tmp_path: Path) -> None:
     """The target lies north of a UAV facing east: its gimbal pans a full turn and finds it;
-    the frame is kept at half resolution with the target's pixels in it."""
+    the frame is kept at half resolution with the target's pixels in it (a run recording)."""
     sim = sim_with({"id": "uav1", "kind": "uav", "start": [70.0, 81.0, 0]},
-                   target=[70.0, 82.6, 0.5])
+                   target=[70.0, 82.6, 0.5], out_dir=tmp_path / "out")
     robot = sim.robots["uav1"]
     sim.start()
     sim.enqueue("uav1", "take_off")  # it starts on the ground
@@ -90,6 +91,22 @@ def test_a_hovering_uav_looks_around_and_keeps_the_detection_frame() -> None:
     assert (kept.segmentation == sim.cosim.target_body + 1).sum() * 4 == pytest.approx(
         hit.pixels, rel=0.2)
     assert not frames[0].detection  # the frame kept at the record rate, before
+    sim.finish()
+
+
+@pytest.mark.parametrize("recording", [True, False])
+def test_frames_at_the_record_rate_are_rendered_only_for_a_recording(
+        tmp_path: Path, recording: bool) -> None:
+    """A look from the UGV facing the target renders its detection frame; the half-size
+    frame kept at the record rate is rendered too when the run records, and not without a
+    recording (nothing would read it). The detection is the same either way."""
+    sim = sim_with(UGV, out_dir=tmp_path / "out" if recording else None)
+    hit = sim.cosim.look(sim.robots["ugv1"], sim.sensor)
+    assert hit is not None and hit.pixels is not None and hit.pixels >= 1000
+    perception = sim.cosim.perception
+    assert perception.clock.calls["camera"] == (2 if recording else 1)
+    assert [frame.detection for frame in perception.frames] == \
+        ([False, True] if recording else [True])
     sim.finish()
 
 

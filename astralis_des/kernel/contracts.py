@@ -7,7 +7,8 @@ plug-ins and wires them; the plug-ins import only the kernel and what lies below
 
 - :class:`MotionOutcome`: how a motion ended (what a co-simulation's events carry).
 - :class:`Host`: what a run offers a co-simulation and its sensors (time, the event log,
-  the mission, the world and its scene, the robots, the routes, the target).
+  the mission, the world and its scene, the robots, the routes, the target, and whether
+  its outputs record what the sensors saw).
 - :class:`CoSim`: a fidelity; it turns each robot's motions and looks into simulated time.
   What only some fidelities can do is declared, not probed: ``body_pose`` and
   ``perception`` are ``None`` where the fidelity simulates no body and no sensor of its own.
@@ -69,6 +70,11 @@ class Host(Protocol):
     def robots(self) -> dict[str, Robot]: ...
     @property
     def target(self) -> Target: ...
+    @property
+    def recorded(self) -> bool:
+        """Whether the run's outputs keep what the sensors saw (a recording or an MCAP
+        file): without, the frames kept only for them need not be rendered."""
+        ...
 
 
 class Sensor(Protocol):

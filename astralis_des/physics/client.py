@@ -19,6 +19,7 @@ from astralis_des.world.model import BLOCK, World
 __all__ = ["GRAVITY", "PhysicsClient", "quiet_c_output"]
 
 GRAVITY = 9.81
+READS = ("get", "compute", "ray")  # what ``call`` may ask without moving any body
 COMPOUND = 16  # shapes PyBullet keeps in one compound (MAX_COMPOUND_COLLISION_SHAPES)
 MESH_BOXES = 1000  # boxes in one mesh body: 8,000 vertices, under what one call may pass
 
@@ -28,6 +29,13 @@ class PhysicsClient:
 
     The static geometry is compound bodies of boxes (simple shapes, few broadphase entries);
     the ground is a plane. ``step`` counts the wall time spent inside ``stepSimulation``.
+
+    A body's base pose and velocity (``base_pose``, ``base_velocity``) are read from PyBullet
+    once between two changes of the state (a step, or a ``call`` that is not a read): the
+    controllers, the checks and the sensors of one tick ask for the same numbers, and each
+    read costs PyBullet a request of the body's whole state. Whatever sets a body's pose or
+    velocity does it through ``call`` (or ``place``), not through ``pybullet`` itself, so
+    that the next read sees it.
     """
 
     def __init__(self, world: World, dt: float, substeps: int, solver_iterations: int) -> None:
@@ -37,6 +45,10 @@ class PhysicsClient:
         self.substeps = substeps
         self.step_time = 0.0  # seconds of wall time inside stepSimulation
         self.steps = 0  # physics steps of dt taken
+        self.changes = 0  # the state's changes so far (steps, calls that set something)
+        self._read_at = 0  # the change the reads kept were made after
+        self._poses: dict[int, tuple[Any, Any]] = {}
+        self._velocities: dict[int, tuple[Any, Any]] = {}
         self.call("setAdditionalSearchPath", pybullet_data.getDataPath())
         self.call("setGravity", 0.0, 0.0, -GRAVITY)
         self.call("setPhysicsEngineParameter", fixedTimeStep=dt * substeps,
@@ -49,7 +61,41 @@ class PhysicsClient:
 
     def call(self, name: str, *args: Any, **kwargs: Any) -> Any:
         """``pybullet.<name>(*args, **kwargs)`` on this client."""
+        if not name.startswith(READS):
+            self.changes += 1
         return getattr(pb, name)(*args, physicsClientId=self.id, **kwargs)
+
+    def base_pose(self, body: int) -> tuple[Any, Any]:
+        """``getBasePositionAndOrientation``: position (x, y, z) and quaternion, as PyBullet
+        gives them, read once since the state last changed."""
+        if self._read_at != self.changes:
+            self._forget()
+        pose = self._poses.get(body)
+        if pose is None:
+            pose = self._poses[body] = pb.getBasePositionAndOrientation(
+                body, physicsClientId=self.id)
+        return pose
+
+    def base_velocity(self, body: int) -> tuple[Any, Any]:
+        """``getBaseVelocity``: linear and angular velocity in the world frame, read once
+        since the state last changed."""
+        if self._read_at != self.changes:
+            self._forget()
+        velocity = self._velocities.get(body)
+        if velocity is None:
+            velocity = self._velocities[body] = pb.getBaseVelocity(body, physicsClientId=self.id)
+        return velocity
+
+    def _forget(self) -> None:
+        self._poses.clear()
+        self._velocities.clear()
+        self._read_at = self.changes
+
+    def place(self, body: int, position: Any, orientation: Any) -> None:
+        """``resetBasePositionAndOrientation`` without ``call``'s look-up (a walker is placed
+        every control period)."""
+        self.changes += 1
+        pb.resetBasePositionAndOrientation(body, position, orientation, physicsClientId=self.id)
 
     def _add_static(self, world: World) -> list[int]:
         """Walls, slabs and obstacles; not what lies wholly below the ground plane (the ground
@@ -118,6 +164,7 @@ class PhysicsClient:
 
     def step(self, calls: int = 1) -> None:
         """Advance ``calls`` x ``substeps`` physics steps of ``dt``."""
+        self.changes += 1
         t0 = time.perf_counter()
         for _ in range(calls):
             pb.stepSimulation(physicsClientId=self.id)

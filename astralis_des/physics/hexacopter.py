@@ -85,19 +85,19 @@ class Hexacopter:
 
     def state(self) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """Position, rotation matrix (body to world), velocity, body angular rate."""
-        pos, quat = self.client.call("getBasePositionAndOrientation", self.body)
-        lin, ang = self.client.call("getBaseVelocity", self.body)
+        pos, quat = self.client.base_pose(self.body)
+        lin, ang = self.client.base_velocity(self.body)
         rot = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
         return np.array(pos), rot, np.array(lin), rot.T @ np.array(ang)
 
     def position(self) -> FloatArray:
-        """Where it is (pybullet at first hand: read every few control periods)."""
-        pos, _ = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client.id)
+        """Where it is (read every few control periods)."""
+        pos, _ = self.client.base_pose(self.body)
         return np.array(pos)
 
     def tilt_deg(self) -> float:
         """Degrees between the body's z axis and the vertical."""
-        _, (qx, qy, _, _) = self.client.call("getBasePositionAndOrientation", self.body)
+        _, (qx, qy, _, _) = self.client.base_pose(self.body)
         return math.degrees(math.acos(min(max(1.0 - 2.0 * (qx * qx + qy * qy), -1.0), 1.0)))
 
     def control(self, p_ref: Vec, v_ref: Vec, yaw_ref: float = 0.0,
@@ -109,9 +109,10 @@ class Hexacopter:
         arithmetic (``np.cross`` alone takes 20 us); the spec's numbers are read into locals
         once (each UAV runs this every control period).
         """
-        cid, body = self.client.id, self.body
-        (px, py, pz), quat = pb.getBasePositionAndOrientation(body, physicsClientId=cid)
-        (vx, vy, vz), (wx, wy, wz) = pb.getBaseVelocity(body, physicsClientId=cid)
+        client, body = self.client, self.body
+        cid = client.id
+        (px, py, pz), quat = client.base_pose(body)
+        (vx, vy, vz), (wx, wy, wz) = client.base_velocity(body)
         r00, r01, r02, r10, r11, r12, r20, r21, r22 = pb.getMatrixFromQuaternion(quat)
         mass, (jx, jy, jz), max_speed = self._mass, self._inertia, self.max_speed
         # position -> velocity -> acceleration, with speed, tilt and climb limits

@@ -73,8 +73,7 @@ class Husky:
 
     def pose(self) -> tuple[float, float, float, float]:
         """x, y, z of the base, and heading."""
-        (x, y, z), quat = pb.getBasePositionAndOrientation(self.body,
-                                                           physicsClientId=self.client.id)
+        (x, y, z), quat = self.client.base_pose(self.body)
         yaw = pb.getEulerFromQuaternion(quat)[2]
         return x, y, z, yaw
 
@@ -84,13 +83,12 @@ class Husky:
 
     def tilt_deg(self) -> float:
         """Degrees between the body's z axis and the vertical (roll and pitch together)."""
-        _, (qx, qy, _, _) = pb.getBasePositionAndOrientation(self.body,
-                                                             physicsClientId=self.client.id)
+        _, (qx, qy, _, _) = self.client.base_pose(self.body)
         return math.degrees(math.acos(min(max(1.0 - 2.0 * (qx * qx + qy * qy), -1.0), 1.0)))
 
     def velocity_in_body(self) -> tuple[float, float]:
         """Forward and lateral speed, m/s: a non-holonomic robot keeps the second near 0."""
-        (vx, vy, _), _ = pb.getBaseVelocity(self.body, physicsClientId=self.client.id)
+        (vx, vy, _), _ = self.client.base_velocity(self.body)
         yaw = self.pose()[3]
         return vx * math.cos(yaw) + vy * math.sin(yaw), -vx * math.sin(yaw) + vy * math.cos(yaw)
 

@@ -70,7 +70,7 @@ class Offscreen:
     def _may_show(self, shape: Shape, eye: FloatArray, rotation: FloatArray,
                   k: Intrinsics) -> bool:
         """Does the body's sphere reach into the frustum (near to far, the image's angles)?"""
-        centre = np.asarray(self.client.call("getBasePositionAndOrientation", shape.body)[0])
+        centre = np.asarray(self.client.base_pose(shape.body)[0])
         x, y, z = (float(v) for v in rotation.T @ (centre - eye))
         r = shape.radius
         if z < k.near - r or z > k.far + r:

@@ -8,7 +8,8 @@
   (about 30 ms at 320 x 240), and the target is detected when at least ``min_pixels`` of its
   segmentation show (within range, when the camera has one). The estimate is the centroid
   of those pixels' depth points.
-  Frames are kept for the recording at ``record_rate``, rendered at half resolution.
+  Frames are kept for the recording at ``record_rate``, rendered at half resolution, when
+  the run's outputs record them (``Host.recorded``): a run without a recording renders none.
 - **Lidars** scan at their rate while their robot moves; a UGV slows down for the nearest
   return ahead of it (the local planner's safety bubble).
 - **IMUs** read at their rate while their robot moves.
@@ -20,8 +21,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Generator, Iterator
-from contextlib import contextmanager
+from collections.abc import Generator
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -61,14 +61,27 @@ class SensorClock:
     seconds: dict[str, float] = field(default_factory=dict)
     calls: dict[str, int] = field(default_factory=dict)
 
-    @contextmanager
-    def timed(self, name: str) -> Iterator[None]:
-        t0 = time.perf_counter()
-        try:
-            yield
-        finally:
-            self.seconds[name] = self.seconds.get(name, 0.0) + time.perf_counter() - t0
-            self.calls[name] = self.calls.get(name, 0) + 1
+    def timed(self, name: str) -> _Timed:
+        """A context that adds its wall time and one call to ``name``'s."""
+        return _Timed(self, name)
+
+
+class _Timed:
+    """One timed sensor call: a plain class, not ``contextlib.contextmanager`` (whose
+    generator costs more than an IMU's reading; sensors are timed thousands of times a run)."""
+
+    __slots__ = ("clock", "name", "t0")
+
+    def __init__(self, clock: SensorClock, name: str) -> None:
+        self.clock, self.name, self.t0 = clock, name, 0.0
+
+    def __enter__(self) -> None:
+        self.t0 = time.perf_counter()
+
+    def __exit__(self, *exc: object) -> None:
+        clock, name = self.clock, self.name
+        clock.seconds[name] = clock.seconds.get(name, 0.0) + time.perf_counter() - self.t0
+        clock.calls[name] = clock.calls.get(name, 0) + 1
 
 
 class Eyes:
@@ -94,6 +107,7 @@ class Perception:
 
     def __init__(self, cosim: Engine, sim: Host) -> None:
         self.cosim, self.env = cosim, sim.env
+        self._host = sim  # asked at each look whether its outputs record the kept frames
         self.clock = SensorClock()
         self.frames: list[KeptFrame] = []
         self.scans: list[KeptScan] = []
@@ -172,7 +186,7 @@ class Perception:
 
     def _look(self, robot: Robot, eyes: Eyes, yaws: list[float | None]) -> Sighting | None:
         now = self.env.now
-        if eyes.spec.record_rate > 0 and now >= eyes.next_keep:
+        if eyes.spec.record_rate > 0 and now >= eyes.next_keep and self._host.recorded:
             eyes.next_keep = now + 1.0 / eyes.spec.record_rate
             with self.clock.timed("camera"):
                 self._keep(robot.id, eyes.small.capture(now, yaws[0]), detection=False)

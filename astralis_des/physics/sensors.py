@@ -37,9 +37,8 @@ _DOWN = (0.0, 0.0, -GRAVITY)  # gravity's acceleration: an IMU at rest reads its
 
 
 def _body_pose(client: PhysicsClient, body: int) -> tuple[FloatArray, FloatArray]:
-    """Position and rotation matrix (world from body) of a body's base (pybullet at first
-    hand: an IMU asks it 20 times a second)."""
-    pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client.id)
+    """Position and rotation matrix (world from body) of a body's base."""
+    pos, quat = client.base_pose(body)
     rotation = pb.getMatrixFromQuaternion(quat, physicsClientId=client.id)
     return np.array(pos), np.array(rotation).reshape(3, 3)
 
@@ -276,9 +275,9 @@ class Imu:
 
         On plain floats (it is read 20 times a second: numpy's calls on 3-vectors cost more
         than their arithmetic), summed in the order of numpy's ``rotation.T @ v``."""
-        _, rotation = _body_pose(self.client, self.body)
-        (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = rotation.tolist()
-        linear, (wx, wy, wz) = pb.getBaseVelocity(self.body, physicsClientId=self.client.id)
+        _, quat = self.client.base_pose(self.body)
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = pb.getMatrixFromQuaternion(quat)
+        linear, (wx, wy, wz) = self.client.base_velocity(self.body)
         vx, vy, vz = linear
         px, py, pz = linear if self._velocity is None else self._velocity
         self._velocity = (vx, vy, vz)

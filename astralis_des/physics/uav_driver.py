@@ -13,7 +13,6 @@ import math
 from pathlib import Path
 
 import numpy as np
-import pybullet as pb
 
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.mission.spec import PhysicsSpec
@@ -123,8 +122,7 @@ class UavDriver(Avoiding):
 
     def crashed(self) -> str | None:
         """Why the craft is down (tipped over, or fallen below its course), if it is."""
-        (_, _, z), (qx, qy, _, _) = pb.getBasePositionAndOrientation(
-            self.body, physicsClientId=self.client.id)  # at first hand: checked at 30 Hz
+        (_, _, z), (qx, qy, _, _) = self.client.base_pose(self.body)  # checked at 30 Hz
         if 1.0 - 2.0 * (qx * qx + qy * qy) < COS_CRASH_TILT:
             return f"crashed: tipped over ({self.craft.tilt_deg():.0f} degrees)"
         drop = float(self.ref[min(self.k, self.last), 2]) - z

@@ -4,7 +4,6 @@ that it collides with robots and is seen by sensors like any body."""
 from __future__ import annotations
 
 import numpy as np
-import pybullet as pb
 
 from astralis_des.physics.client import PhysicsClient
 from astralis_des.world.geometry import FloatArray
@@ -14,8 +13,7 @@ HEIGHT = 1.2  # between the caps: 1.7 m tall in all
 
 
 class Walker:
-    """A person's capsule, placed (not pushed) where its driver says (each control period:
-    pybullet at first hand)."""
+    """A person's capsule, placed (not pushed) where its driver says (each control period)."""
 
     centre_height = RADIUS + HEIGHT / 2  # m from the floor to its centre
 
@@ -27,9 +25,8 @@ class Walker:
 
     def place(self, centre: FloatArray, yaw: float = 0.0) -> None:
         """Put it at ``centre`` (a capsule: upright whichever way it faces)."""
-        pb.resetBasePositionAndOrientation(self.body, [float(v) for v in centre],
-                                           (0.0, 0.0, 0.0, 1.0), physicsClientId=self.client.id)
+        self.client.place(self.body, [float(v) for v in centre], (0.0, 0.0, 0.0, 1.0))
 
     def position(self) -> FloatArray:
-        pos, _ = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client.id)
+        pos, _ = self.client.base_pose(self.body)
         return np.array(pos)

@@ -295,6 +295,13 @@ class Simulation(AssignmentRounds):
         return self._end is not None and self._end.triggered
 
     @property
+    def recorded(self) -> bool:
+        """Whether the outputs keep what the sensors saw: a recording or an MCAP file in
+        ``out_dir`` (the physics cameras' kept frames are rendered only for them)."""
+        cfg = self.mission.spec.outputs
+        return self.out_dir is not None and (cfg.recording or cfg.mcap)
+
+    @property
     def outputs_time(self) -> float:
         """Wall seconds spent writing this run's outputs (event log, summary, recording)."""
         return self._sinks.seconds if self._sinks is not None else 0.0
