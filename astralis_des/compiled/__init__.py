@@ -15,10 +15,13 @@ machine code next to this package (or in numba's cache directory), the later one
 
 from __future__ import annotations
 
+import importlib.util
 import logging
 from types import ModuleType
 
 log = logging.getLogger(__name__)
+
+MANY = 20  # missions a process runs from which the kernels repay numba's import (~0.5 s)
 
 _kernels: ModuleType | None = None
 
@@ -35,6 +38,11 @@ def enable() -> bool:
             return False
         _kernels = loops
     return True
+
+
+def available() -> bool:
+    """Whether numba is installed (without importing it)."""
+    return importlib.util.find_spec("numba") is not None
 
 
 def disable() -> None:
