@@ -93,6 +93,22 @@ def test_sight_lines_are_the_same(kernels: None) -> None:
     assert (fast == plain).all() and not plain.any()
 
 
+def test_rooms_of_points_are_the_same(kernels: None) -> None:
+    """The rooms points lie in, a point's room (bounds included, and 1e-6 beyond)."""
+    world = load_world(ROOT / "worlds" / "urban_default.yaml")
+    boxes = world.room_boxes
+    rng = np.random.default_rng(3)
+    corners = boxes.reshape(-1, 3)
+    points = np.concatenate([rng.uniform(boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0),
+                                         (300, 3)), corners, corners + 1e-6, corners - 2e-6])
+    scene = Simulation(load_mission(ROOT / "missions" / "urban_search.yaml")).scene
+    for cut in (slice(0, 1), slice(0, 40), slice(300, 340), slice(None)):
+        plain, fast = both(lambda c=cut: scene.rooms_at(points[c]))
+        assert fast == plain
+    plain, fast = both(lambda: [world.room_at(p) for p in points])
+    assert fast == plain and any(r is not None for r in plain)
+
+
 @pytest.mark.parametrize(("mission", "seeds"), [("urban_search", range(4)),
                                                 ("hospital_search", range(2))])
 def test_missions_log_the_same_events(kernels: None, mission: str, seeds: range) -> None:

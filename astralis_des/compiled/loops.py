@@ -308,3 +308,19 @@ def segments_hit_boxes(p0, p1, boxes):  # type: ignore[no-untyped-def]
                 out[r] = True
                 break
     return out
+
+
+@compiled
+def within(points, lo, hi, axes):  # type: ignore[no-untyped-def]
+    """``(N, K)``: whether ``points[n]``'s first ``axes`` coordinates lie in the box ``lo[k]``
+    .. ``hi[k]`` (bounds included): the comparisons numpy broadcasts, pair by pair."""
+    out = np.zeros((len(points), len(lo)), dtype=np.bool_)
+    for n in range(len(points)):
+        for k in range(len(lo)):
+            inside = True
+            for a in range(axes):
+                if not (points[n, a] >= lo[k, a] and points[n, a] <= hi[k, a]):
+                    inside = False
+                    break
+            out[n, k] = inside
+    return out
