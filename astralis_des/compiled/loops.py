@@ -5,10 +5,14 @@ more on a call's overhead than on the arithmetic (a room's grid is 44 x 74 cells
 
 - :func:`fits`: ``world.clutter._candidates``, the lower corners where a footprint's window
   holds only allowed cells (along a wall: with its back on the wall);
-- :func:`try_stamp`: ``world.placing.Occupancy.try_stamp``, a footprint stamped and kept when
-  every cell reached from the door before is still reached (a flood fill from the door);
+- :func:`place`: ``world.clutter.place_in``'s tries, each spot's cells worked out with the
+  same floating-point steps as ``_Layout.spot`` and ``FreeSpace.cells``, and stamped by
+  :func:`try_stamp` (``world.placing.Occupancy.try_stamp``: a footprint is kept when every
+  cell reached from the door before is still reached, here by a flood fill from the door);
 - :func:`segments_hit_boxes`: ``world.geometry.segments_hit_boxes``, the slab test with
-  numpy's products and comparisons one by one (and its NaN and zero-direction rules).
+  numpy's products and comparisons one by one (and its NaN and zero-direction rules);
+- :func:`within`: which points lie in which boxes (rooms, furniture), the comparisons numpy
+  broadcasts.
 """
 
 from __future__ import annotations

@@ -12,11 +12,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from functools import lru_cache
-from types import ModuleType
 
 import numpy as np
 
-from astralis_des.compiled import kernels
 from astralis_des.memo import kept
 from astralis_des.world.freespace import BoolArray, FreeSpace, IntArray
 from astralis_des.world.geometry import Box
@@ -103,9 +101,6 @@ class Occupancy:
     def try_stamp(self, space: FreeSpace, box: Box, clearance: float, passage: float) -> bool:
         """Stamp ``box`` if every cell reached from the door before is still reached (or
         lies under it, grown by half the ``passage``), and say whether it was kept."""
-        compiled = kernels()
-        if compiled is not None:
-            return self._try_stamp_compiled(compiled, space, box, clearance, passage)
         undo = self.stamp(space, box, clearance)
         stamped, taken_before = undo[0][1], undo[0][2]
         radius = passage / 2 / space.cell
@@ -132,25 +127,9 @@ class Occupancy:
         self.reach, self.walk_eroded = reach, walk_eroded
         return True
 
-    def _try_stamp_compiled(self, compiled: ModuleType, space: FreeSpace, box: Box,
-                            clearance: float, passage: float) -> bool:
-        """:meth:`try_stamp` by the compiled kernel: the same cells taken and reached."""
-        rows, cols = space.cells(box.lo, box.hi)
-        grow = (clearance, clearance, 0.0)
-        halo_rows, halo_cols = space.cells(
-            tuple(a - g for a, g in zip(box.lo, grow, strict=True)),
-            tuple(a + g for a, g in zip(box.hi, grow, strict=True)))
-        kept, reach, walk_eroded = compiled.try_stamp(
-            space.free, space.open_floor, space.inside, space.door, self.taken, self.halo,
-            self.reach, self.walk_eroded, (rows.start, rows.stop, cols.start, cols.stop),
-            (halo_rows.start, halo_rows.stop, halo_cols.start, halo_cols.stop),
-            disk_rows(passage / 2 / space.cell))
-        if kept:
-            self.kept_compiled(reach, walk_eroded)
-        return bool(kept)
-
     def kept_compiled(self, reach: BoolArray, walk_eroded: BoolArray) -> None:
-        """A footprint the compiled kernels stamped and kept: what it reaches and erodes."""
+        """A footprint the compiled kernels stamped and kept (``compiled.loops.place``, as
+        :meth:`try_stamp` would have): what it reaches and erodes now."""
         self.reach, self.walk_eroded = reach, walk_eroded
         self.near.clear()  # made again from ``taken`` when asked (the kernels do not keep it)
 
