@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from astralis_des.compiled import kernels
 from astralis_des.detection import PROBES, Sighting, cull, predict_pixels, shows_unhidden
 from astralis_des.kernel.robot import Motion, Robot
 from astralis_des.kinds import TARGET_HEIGHT
@@ -121,9 +122,13 @@ class GeometricSensor:
         boxes = self.scene.still_boxes([room.id])
         keep = np.ones(len(full), dtype=bool)
         if len(boxes):
-            x, y = full[:, 0:1], full[:, 1:2]  # axis by axis: the same cells, fewer calls
-            under = ((x >= boxes[None, :, 0, 0]) & (x <= boxes[None, :, 1, 0])
-                     & (y >= boxes[None, :, 0, 1]) & (y <= boxes[None, :, 1, 1]))
+            compiled = kernels()
+            if compiled is not None:  # the same cells, pair by pair
+                under = compiled.within(full, boxes[:, 0], boxes[:, 1], 2)
+            else:
+                x, y = full[:, 0:1], full[:, 1:2]  # axis by axis: the same cells, fewer calls
+                under = ((x >= boxes[None, :, 0, 0]) & (x <= boxes[None, :, 1, 0])
+                         & (y >= boxes[None, :, 0, 1]) & (y <= boxes[None, :, 1, 1]))
             keep = ~np.asarray(under.any(axis=1))
             if not keep.any():
                 return 0.0
@@ -260,6 +265,10 @@ def _within(world: World, room: Room, pts: FloatArray) -> bool:
     """Whether no point of ``pts`` lies in a room other than ``room`` (then the sight lines of
     its coverage meet no furniture but that of ``room``: Scene.line_of_sight)."""
     boxes = world.room_boxes
+    compiled = kernels()
+    if compiled is not None:  # the same rooms, pair by pair
+        held = compiled.within(pts, boxes[:, 0], boxes[:, 1], 3).any(axis=0)
+        return all(world.room_ids[k] == room.id for k in np.flatnonzero(held).tolist())
     near = np.flatnonzero(np.all((boxes[:, 0] <= pts.max(axis=0)) &
                                  (boxes[:, 1] >= pts.min(axis=0)), axis=1))
     ids = world.room_ids

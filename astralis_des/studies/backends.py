@@ -11,6 +11,7 @@ from collections.abc import Callable, Generator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
+from astralis_des import compiled
 from astralis_des.errors import InputError
 from astralis_des.physics.quiet import quiet_c_output
 from astralis_des.registry import Registry, UnknownEntry
@@ -78,6 +79,8 @@ class LocalBackend:
             recordings: Path | None) -> Generator[ChunkResult, None, None]:
         indices = [i for chunk in chunks for i in chunk]
         if self.workers == 1 or len(indices) == 1:
+            if len(indices) >= compiled.MANY:  # this process runs them all
+                compiled.enable()
             for chunk in chunks:
                 yield run_chunk(study, chunk, recordings)
             return
@@ -85,7 +88,8 @@ class LocalBackend:
         if held is not None and study.origin is not None and study.origin[0] is held.base:
             yield from held.run(study, study.origin[1], indices, recordings)
             return
-        pool = WorkerPool(study, min(self.workers, len(indices)))
+        pool = WorkerPool(study, min(self.workers, len(indices)),
+                          fast=len(indices) >= compiled.MANY)
         try:
             yield from pool.run(study, None, indices, recordings)
         finally:  # also on Ctrl-C or an error
@@ -101,6 +105,7 @@ class _RayWorker:
 
     def __init__(self, study: Study) -> None:
         self.study = study
+        compiled.enable()  # an actor runs chunk after chunk
 
     def run(self, indices: list[int], recordings: Path | None) -> ChunkResult:
         return run_chunk(self.study, indices, recordings)

@@ -29,6 +29,7 @@ from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from astralis_des import compiled
 from astralis_des.exits import default_termination, deferred_interrupts
 from astralis_des.studies.scenarios import ChunkResult, failed_scenario, run_chunk
 
@@ -62,13 +63,16 @@ def _orphan_proof(parent: int) -> None:
         os._exit(0)
 
 
-def _serve(conn: Connection, base: Study, parent: int) -> None:
+def _serve(conn: Connection, base: Study, parent: int, fast: bool) -> None:
     """A worker: scenarios of ``base`` (or of ``base.with_changes(**changes)``, made once per
-    changes) until told to stop, or until its parent is gone."""
+    changes) until told to stop, or until its parent is gone; ``fast``: with the compiled
+    kernels (many scenarios to run)."""
     default_termination()  # SIGTERM ends a worker
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     _orphan_proof(parent)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, SIGNALS)
+    if fast:
+        compiled.enable()
     made: tuple[dict[str, Any], Study] | None = None
     while True:
         try:
@@ -91,11 +95,11 @@ def _serve(conn: Connection, base: Study, parent: int) -> None:
 
 
 class _Worker:
-    def __init__(self, base: Study) -> None:
+    def __init__(self, base: Study, fast: bool) -> None:
         self.conn, child = multiprocessing.Pipe()
         _PARENT_ENDS.add(self.conn)
         self.process: BaseProcess = multiprocessing.get_context("fork").Process(
-            target=_serve, args=(child, base, os.getpid()), daemon=True)
+            target=_serve, args=(child, base, os.getpid(), fast), daemon=True)
         held = signal.pthread_sigmask(signal.SIG_BLOCK, SIGNALS)
         try:
             self.process.start()
@@ -111,11 +115,13 @@ class _Worker:
 
 class WorkerPool:
     """Up to ``workers`` processes holding ``base``, started as needed and kept until
-    :meth:`close` (a tune's trials reuse them)."""
+    :meth:`close` (a tune's trials reuse them); ``fast``: their missions on the compiled
+    kernels (:mod:`astralis_des.compiled`), for pools that run many."""
 
-    def __init__(self, base: Study, workers: int) -> None:
+    def __init__(self, base: Study, workers: int, fast: bool = True) -> None:
         self.base = base
         self.workers = max(1, workers)
+        self.fast = fast
         self._idle: list[_Worker] = []
 
     def run(self, study: Study, changes: dict[str, Any] | None, indices: Sequence[int],
@@ -131,7 +137,7 @@ class WorkerPool:
                     with deferred_interrupts():  # an interrupt (a signal, or one the import
                         # guard of exits.py raises again) lands once the worker is known, to
                         # be ended below: never between its fork and ``busy``
-                        worker = self._idle.pop() if self._idle else _Worker(self.base)
+                        worker = self._idle.pop() if self._idle else _Worker(self.base, self.fast)
                         busy[worker.conn] = worker
                     worker.send((changes, todo.popleft(), recordings))
                 ready = wait([*busy, *(w.process.sentinel for w in busy.values())])

@@ -12,20 +12,23 @@ import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any
 
 import numpy as np
 
+from astralis_des.compiled import kernels
 from astralis_des.errors import suggest
 from astralis_des.streams import stream
 from astralis_des.world.catalogue import Catalogue, agree, avatar_size, default_catalogue
 from astralis_des.world.freespace import BoolArray, FreeSpace, room_free_space
 from astralis_des.world.geometry import Box
-from astralis_des.world.grids import summed, wall_windows, window
+from astralis_des.world.grids import summed, wall_sides, wall_windows, window
 from astralis_des.world.model import Room, World
-from astralis_des.world.placing import Occupancy
+from astralis_des.world.placing import Occupancy, disk_rows
 
 ATTEMPTS = 30  # spots tried per item before it is skipped
+CUT_OFF = "every spot tried cuts off free floor from the door"
 AVATAR = "avatar"
 
 
@@ -197,10 +200,13 @@ def place_in(space: FreeSpace, occupied: Occupancy, footprint: Sequence[float],
     along the traced boundary; ``turn`` allows a quarter turn of a free-standing footprint.
     """
     w, d = float(footprint[0]), float(footprint[1])
+    compiled = kernels()
+    if compiled is not None:
+        return _place_compiled(compiled, space, occupied, (w, d), against_wall, turn, rng,
+                               clearance, passage, attempts)
     candidates = _candidates(space, occupied, w, d, against_wall, clearance, turn)
     if not candidates:
-        where = "along a wall" if against_wall else "on the free floor"
-        return f"no {w:.2f} x {d:.2f} m spot {where}"
+        return _no_spot(w, d, against_wall)
     bounds = list(itertools.accumulate(len(c[1]) for c in candidates))
     total = bounds[-1]
     tries = rng.choice(total, size=min(attempts, total), replace=False)
@@ -211,7 +217,44 @@ def place_in(space: FreeSpace, occupied: Occupancy, footprint: Sequence[float],
         spot = layout.spot(space, divmod(int(corners[offset]), width))
         if occupied.try_stamp(space, _footprint_box(spot), clearance, passage):
             return spot
-    return "every spot tried cuts off free floor from the door"
+    return CUT_OFF
+
+
+def _no_spot(w: float, d: float, against_wall: bool) -> str:
+    where = "along a wall" if against_wall else "on the free floor"
+    return f"no {w:.2f} x {d:.2f} m spot {where}"
+
+
+def _place_compiled(compiled: ModuleType, space: FreeSpace, occupied: Occupancy,
+                    footprint: tuple[float, float], against_wall: bool, turn: bool,
+                    rng: np.random.Generator, clearance: float, passage: float,
+                    attempts: int) -> Spot | str:
+    """:func:`place_in` by the compiled kernels: the same spots found in the same order,
+    the same draws, the same tries stamped (``occupied`` updated as its ``try_stamp`` does)."""
+    layouts = _layouts(*footprint, space.cell, against_wall, turn)
+    cells = np.array([(*layout.cells, layout.wall) for layout in layouts])
+    corners, counts = compiled.fits(
+        space.free, occupied.keepout, occupied.halo, occupied.taken, wall_sides(space),
+        math.ceil(clearance / space.cell - 1e-6), cells)
+    total = len(corners)
+    if total == 0:
+        return _no_spot(*footprint, against_wall)
+    tries = rng.choice(total, size=min(attempts, total), replace=False)
+    kept, reach, walk_eroded = compiled.place(
+        space.free, space.open_floor, space.inside, space.door, occupied.taken, occupied.halo,
+        occupied.reach, occupied.walk_eroded, corners, counts, cells,
+        np.array([layout.extent for layout in layouts]), tries, space.origin, space.cell,
+        clearance, disk_rows(passage / 2 / space.cell))
+    if kept < 0:
+        return CUT_OFF
+    occupied.kept_compiled(reach, walk_eroded)
+    pick, which = int(tries[kept]), 0
+    while pick >= counts[which]:
+        pick -= int(counts[which])
+        which += 1
+    layout = layouts[which]
+    return layout.spot(space, divmod(int(corners[tries[kept]]), space.shape[1] - layout.cells[1]
+                                     + 1))
 
 
 @dataclass(frozen=True)

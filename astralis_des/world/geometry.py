@@ -7,6 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from astralis_des.compiled import kernels
+
 FloatArray = NDArray[np.float64]
 
 
@@ -53,6 +55,12 @@ def segments_hit_boxes(p0: FloatArray, p1: FloatArray, boxes: FloatArray) -> NDA
     p1 = np.atleast_2d(np.asarray(p1, dtype=float))
     if len(boxes) == 0 or len(p0) == 0:
         return np.zeros(len(p0), dtype=bool)
+    compiled = kernels()
+    if compiled is not None and p0.shape == p1.shape and p0.shape[1] == 3:  # pair by pair
+        found: NDArray[np.bool_] = compiled.segments_hit_boxes(
+            np.ascontiguousarray(p0), np.ascontiguousarray(p1),
+            np.ascontiguousarray(boxes, dtype=float))
+        return found
     # Only boxes whose extent meets the segments' common bounding box can be hit.
     lo = np.minimum(p0.min(axis=0), p1.min(axis=0))
     hi = np.maximum(p0.max(axis=0), p1.max(axis=0))

@@ -128,11 +128,11 @@ def disk_grown(radius: float, lost: Cells) -> list[Cells]:
     if i0 >= i1 or j0 >= j1:
         return []
     return [(slice(max(i0 - di, 0), i1 + di), slice(max(j0 - h, 0), j1 + h))
-            for di, h in _disk(radius)]
+            for di, h in disk(radius)]
 
 
 @lru_cache(maxsize=256)
-def _disk(radius: float) -> tuple[tuple[int, int], ...]:
+def disk(radius: float) -> tuple[tuple[int, int], ...]:
     """A disk of ``radius`` cells as rows ``di`` off its centre and their half widths ``h``."""
     reach = math.floor(radius + 1e-9)
     return tuple((di, math.floor(math.sqrt(radius * radius - di * di) + 1e-9))
@@ -151,6 +151,17 @@ def reachable(space: FreeSpace, taken: BoolArray, passage: float,
     from_door[labels[space.door & eroded]] = True
     from_door[0] = False
     return eroded, from_door[labels]
+
+
+def wall_sides(space: FreeSpace) -> BoolArray:
+    """The room's :meth:`FreeSpace.wall_sides` (read-only: kept on its free space)."""
+    kept_backs: dict[object, Any] = kept(space, "wall_backs", 4096)
+    if "wall sides" not in kept_backs:
+        sides = space.wall_sides()
+        sides.setflags(write=False)
+        kept_backs["wall sides"] = sides
+    found: BoolArray = kept_backs["wall sides"]
+    return found
 
 
 def backs_onto_wall(space: FreeSpace, wall: int, kx: int, ky: int) -> BoolArray:

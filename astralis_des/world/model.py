@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from astralis_des.compiled import kernels
 from astralis_des.memo import kept
 from astralis_des.world.geometry import FloatArray, boxes_array, inside_polygon
 from astralis_des.world.interior_routes import side_of
@@ -194,10 +195,19 @@ class World:
         """``(R, 2, 3)`` corners of the rooms, in ``room_ids`` order."""
         return boxes_array([self.rooms[r].box for r in self.room_ids])
 
+    @cached_property
+    def room_bounds(self) -> tuple[FloatArray, FloatArray]:
+        """The rooms' corners widened by 1e-6 (:meth:`room_at`'s tolerance)."""
+        return self.room_boxes[:, 0] - 1e-6, self.room_boxes[:, 1] + 1e-6
+
     def room_at(self, point: tuple[float, ...] | FloatArray) -> Room | None:
         p = np.asarray(point, dtype=float)
         boxes = self.room_boxes
-        inside = np.all((p >= boxes[:, 0] - 1e-6) & (p <= boxes[:, 1] + 1e-6), axis=1)
+        compiled = kernels()
+        if compiled is not None and p.shape == (3,):  # the same rooms, one by one
+            inside = compiled.within(p[None], *self.room_bounds, 3)[0]
+        else:
+            inside = np.all((p >= boxes[:, 0] - 1e-6) & (p <= boxes[:, 1] + 1e-6), axis=1)
         for k in np.flatnonzero(inside):  # a room that is no box: in its outline
             room = self.rooms[self.room_ids[k]]
             if not room.outline or inside_polygon(p[None, :2], room.outline)[0]:

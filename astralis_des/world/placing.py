@@ -20,6 +20,7 @@ from astralis_des.world.freespace import BoolArray, FreeSpace, IntArray
 from astralis_des.world.geometry import Box
 from astralis_des.world.grids import (
     Cells,
+    disk,
     disk_grown,
     erode,
     erode_near,
@@ -125,6 +126,18 @@ class Occupancy:
             return False
         self.reach, self.walk_eroded = reach, walk_eroded
         return True
+
+    def kept_compiled(self, reach: BoolArray, walk_eroded: BoolArray) -> None:
+        """A footprint the compiled kernels stamped and kept (``compiled.loops.place``, as
+        :meth:`try_stamp` would have): what it reaches and erodes now."""
+        self.reach, self.walk_eroded = reach, walk_eroded
+        self.near.clear()  # made again from ``taken`` when asked (the kernels do not keep it)
+
+
+@lru_cache(maxsize=256)
+def disk_rows(radius: float) -> IntArray:
+    """:func:`grids.disk_grown`'s disk as an array (rows off its centre, half widths)."""
+    return np.array(disk(radius), dtype=np.int64).reshape(-1, 2)
 
 
 def _set(undo: Undo, array: BoolArray, cells: Cells) -> None:

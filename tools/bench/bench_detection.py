@@ -117,6 +117,14 @@ def one(job: tuple[int, str]) -> dict[str, Any]:
     return row
 
 
+def fast_worker() -> None:
+    """A worker's start-up: it runs many missions, so on the compiled kernels (the same
+    outcomes; numba's import repaid) where numba is installed."""
+    from astralis_des import compiled
+
+    compiled.enable()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--scenarios", type=int, default=1000)
@@ -126,7 +134,7 @@ def main() -> None:
     strategies = args.strategies.split(",")
     jobs = [(i, s) for i in range(args.scenarios) for s in strategies]
     t0 = time.perf_counter()
-    with ProcessPoolExecutor(args.workers) as pool:
+    with ProcessPoolExecutor(args.workers, initializer=fast_worker) as pool:
         rows = list(pool.map(one, jobs, chunksize=8))
     print(f"# {args.scenarios} scenarios x {len(strategies)} strategies (kinematic), "
           f"{time.perf_counter() - t0:.0f} s on {args.workers} workers")

@@ -127,6 +127,14 @@ def agreement(rows: list[dict[str, Any]]) -> list[str]:
     ]
 
 
+def fast_worker() -> None:
+    """A worker's start-up: it runs many missions, so on the compiled kernels (the same
+    outcomes; numba's import repaid) where numba is installed."""
+    from astralis_des import compiled
+
+    compiled.enable()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--scenarios", type=int, default=30)
@@ -141,7 +149,7 @@ def main() -> None:
             for s in args.strategies.split(",")]
     jobs.sort(key=lambda j: j[2] != "physics")  # the long ones first
     t0 = time.perf_counter()
-    with ProcessPoolExecutor(args.workers) as pool:
+    with ProcessPoolExecutor(args.workers, initializer=fast_worker) as pool:
         rows = list(pool.map(one, jobs, chunksize=1))
     rows.sort(key=lambda r: (r["fidelity"], r["scenario"], r["strategy"]))
     print(f"# {args.scenarios} scenarios x {len(args.strategies.split(','))} strategies, "

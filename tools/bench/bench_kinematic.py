@@ -33,7 +33,7 @@ import simpy
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from astralis_des import Simulation, load_mission  # noqa: E402
+from astralis_des import Simulation, compiled, load_mission  # noqa: E402
 from astralis_des.simulation.result import RunResult  # noqa: E402
 
 
@@ -76,6 +76,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--workers", type=int, default=2,
                         help="also run the missions on this many processes")
+    parser.add_argument("--numpy", action="store_true",
+                        help="the missions' workers without the compiled kernels (numba)")
     args = parser.parse_args()
     mission_file = ROOT / "missions" / "urban_search.yaml"
 
@@ -135,12 +137,14 @@ def main() -> None:
 
     if args.missions < 1:  # --missions 0: the single mission's figures only
         return
-    print(f"{args.missions} kinematic missions, recording off (seeds 0..{args.missions - 1}):")
+    kernels = "numpy" if args.numpy or not compiled.available() else "compiled kernels (numba)"
+    print(f"{args.missions} kinematic missions, recording off (seeds 0..{args.missions - 1}), "
+          f"{kernels}:")
     single = None
     for workers in sorted({1, args.workers}):
         t0 = time.perf_counter()
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
-                                 initializer=load_once) as pool:
+                                 initializer=load_once, initargs=(not args.numpy,)) as pool:
             runs = list(pool.map(run_seed, range(args.missions), chunksize=25))
         total = time.perf_counter() - t0
         single = single or total
@@ -202,8 +206,12 @@ def first_run(mission_file: Path, env: dict[str, str]) -> dict[str, float]:
 _MISSION = None
 
 
-def load_once() -> None:
+def load_once(fast: bool = True) -> None:
+    """A worker's start-up, as a study's: the mission, and the compiled kernels (unless
+    ``--numpy``) since it runs many missions."""
     global _MISSION
+    if fast:
+        compiled.enable()
     _MISSION = load_mission(ROOT / "missions" / "urban_search.yaml")
 
 
