@@ -263,3 +263,41 @@ def test_the_random_policy_draws_what_rng_choice_draws() -> None:
             theirs.choice(np.flatnonzero(mask)))
     assert ours.integers(2**62) == theirs.integers(2**62)
     assert random_policy({"action_mask": np.zeros(129, dtype=np.int8)}, ours) == CONTINUE
+
+
+def test_a_long_training_run_goes_on_on_the_compiled_kernels_with_the_same_episodes() -> None:
+    """From its MANY-th episode an env runs compiled (a training run repays numba's import);
+    the episode after it observes what the numpy path observes, step for step."""
+    from astralis_des import compiled
+
+    pytest.importorskip("numba")
+    compiled.disable()
+    try:
+        env = MissionEnv(DEFAULT)
+        for episode in range(1, compiled.MANY):
+            env.reset(seed=episode)
+            assert compiled.kernels() is None, episode
+        env.reset(seed=compiled.MANY)
+        assert compiled.kernels() is not None
+
+        def episode_of(seed: int) -> list[Any]:
+            env.reset(seed=seed)
+            seen, rng = [], np.random.default_rng(0)
+            for agent in env.agent_iter():
+                obs, reward, term, trunc, _ = env.last()
+                seen.append((agent, reward, _plain(obs)))
+                env.step(None if term or trunc else random_policy(obs, rng))
+            return seen
+
+        fast = episode_of(7)
+        compiled.disable()
+        assert episode_of(7) == fast
+    finally:
+        compiled.disable()
+
+
+def _plain(value: Any) -> Any:
+    """An observation as lists and numbers, to compare whole."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    return np.asarray(value).tolist()

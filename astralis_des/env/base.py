@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
+from astralis_des import compiled
 from astralis_des.env.layout import Layout
 from astralis_des.env.observe import Observer, observation_space, state_space
 from astralis_des.env.rewards import Progress, RewardFn, RewardWeights
@@ -74,6 +75,8 @@ class Episodes:
             episode_seed = int(self._draws.integers(2**31 - 1))
         self._seed = episode_seed
         self.episode += 1
+        if self.episode == compiled.MANY:  # a training run: numba's import repays from here
+            compiled.enable()  # (the same episodes, bit for bit; without numba, numpy's path)
         mission = (self.mission if episode_seed == self.mission.spec.seed
                    else self.mission.with_changes(seed=episode_seed))
         out = self.out_dir / f"episode_{self.episode:04d}" if self.out_dir else None
