@@ -142,3 +142,25 @@ def test_without_numba_the_numpy_path_runs(tmp_path: Path) -> None:
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                           cwd=ROOT, check=True)
     assert done.stdout.split() == ["False", "True", "found"]
+
+
+def test_where_numba_cannot_keep_its_machine_code_the_numpy_path_runs() -> None:
+    """A read-only install and home: numba refuses to compile with ``cache=True`` (its
+    RuntimeError, "no locator available"); enabling says so in one line and stays on numpy's
+    path instead of failing a study's workers."""
+    script = ("import sys, types\n"
+              "fake = types.ModuleType('numba')\n"
+              "def njit(**options):\n"
+              "    def compile(function):\n"
+              "        raise RuntimeError('cannot cache function: no locator available')\n"
+              "    return compile\n"
+              "fake.njit = njit\n"
+              "sys.modules['numba'] = fake\n"
+              "from astralis_des import compiled\n"
+              "print(compiled.enable(), compiled.kernels() is None)")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          check=True)
+    assert done.stdout.split() == ["False", "True"]
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "compiled kernels not enabled" in lines[0] \
+        and "NUMBA_CACHE_DIR" in lines[0]

@@ -28,13 +28,18 @@ _kernels: ModuleType | None = None
 
 def enable() -> bool:
     """Use the compiled kernels in this process from now on; False (the numpy path stays)
-    where numba is not installed."""
+    where numba is not installed, or cannot keep its machine code anywhere (a read-only
+    install and home: numba refuses to compile with ``cache=True`` there)."""
     global _kernels
     if _kernels is None:
         try:
             from astralis_des.compiled import loops
         except ImportError as missing:  # numba is an optional extra: the numpy path
             log.info("compiled kernels not enabled (%s): the numpy path", missing)
+            return False
+        except (RuntimeError, OSError) as unusable:  # no folder numba may cache into
+            log.warning("compiled kernels not enabled (%s): the numpy path (set "
+                        "NUMBA_CACHE_DIR to a writable folder to use them)", unusable)
             return False
         _kernels = loops
     return True
