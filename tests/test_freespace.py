@@ -117,8 +117,9 @@ def test_unknown_room_suggests_a_close_one(world: World) -> None:
 
 
 def test_grid_winding_counts_as_winding_does_on_every_point() -> None:
-    """The grid's winding numbers, judged row by row, are winding()'s for each cell centre:
-    random segments, and segments with their ends on cell centres and edges (the ties)."""
+    """The grid's winding numbers, judged row by row, are the crossing rule's for each cell
+    centre judged against every segment (as free space was traced before): random segments,
+    and segments with their ends on cell centres and edges (the ties)."""
     rng = np.random.default_rng(7)
     for trial in range(200):
         nx, ny = (int(n) for n in rng.integers(1, 50, 2))
@@ -128,5 +129,19 @@ def test_grid_winding_counts_as_winding_does_on_every_point() -> None:
             segments = np.round(segments * 20) / 20
         xs = lo[0] + (np.arange(nx) + 0.5) * 0.1
         ys = lo[1] + (np.arange(ny) + 0.5) * 0.1
-        expected = freespace.winding(freespace.cell_centers(lo, (nx, ny), 0.1), segments)
+        expected = _winding(freespace.cell_centers(lo, (nx, ny), 0.1), segments)
         assert np.array_equal(freespace.grid_winding(xs, ys, segments), expected), trial
+
+
+def _winding(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """Sunday's crossing rule, each point against every segment at once."""
+    segments = segments[segments[:, 0, 1] != segments[:, 1, 1]]
+    if len(segments) == 0:
+        return np.zeros(len(points), dtype=np.int64)
+    p, q = segments[None, :, 0], segments[None, :, 1]
+    pt = points[:, None, :]
+    side = (q[..., 0] - p[..., 0]) * (pt[..., 1] - p[..., 1]) - \
+        (pt[..., 0] - p[..., 0]) * (q[..., 1] - p[..., 1])
+    upward = (p[..., 1] <= pt[..., 1]) & (q[..., 1] > pt[..., 1]) & (side > 0)
+    downward = (q[..., 1] <= pt[..., 1]) & (p[..., 1] > pt[..., 1]) & (side < 0)
+    return np.asarray(upward.sum(axis=1) - downward.sum(axis=1), dtype=np.int64)

@@ -145,26 +145,12 @@ def slice_segments(vertices: FloatArray, faces: IntArray, z: float) -> FloatArra
     return np.stack([p, q], axis=1)
 
 
-def winding(points: FloatArray, segments: FloatArray) -> IntArray:
-    """Winding number of each point about the oriented segments (Sunday's crossing rule)."""
-    # a level segment never crosses a ray towards +x: it counts for no point
-    segments = segments[segments[:, 0, 1] != segments[:, 1, 1]]
-    if len(segments) == 0:
-        return np.zeros(len(points), dtype=np.int64)
-    p, q = segments[None, :, 0], segments[None, :, 1]
-    pt = points[:, None, :]
-    side = (q[..., 0] - p[..., 0]) * (pt[..., 1] - p[..., 1]) - \
-        (pt[..., 0] - p[..., 0]) * (q[..., 1] - p[..., 1])
-    upward = (p[..., 1] <= pt[..., 1]) & (q[..., 1] > pt[..., 1]) & (side > 0)
-    downward = (q[..., 1] <= pt[..., 1]) & (p[..., 1] > pt[..., 1]) & (side < 0)
-    return np.asarray(upward.sum(axis=1) - downward.sum(axis=1), dtype=np.int64)
-
-
 def grid_winding(xs: np.ndarray, ys: np.ndarray, segments: FloatArray) -> IntArray:
-    """:func:`winding` of the grid points ``(xs[i], ys[j])``, in ``[i, j]`` order: the same
-    numbers, the same sums. A segment counts only for the rows of points its y span takes in
-    (the crossing rule's first test), so each row is judged against the few segments that
-    cross it rather than against all of them."""
+    """Winding number of each grid point ``(xs[i], ys[j])`` about the oriented segments
+    (Sunday's crossing rule), in ``[i, j]`` order. A segment counts only for the rows of
+    points its y span takes in (the rule's first test), so each row is judged against the
+    few segments that cross it rather than against all of them; a level segment never
+    crosses a ray towards +x and counts for no point."""
     segments = segments[segments[:, 0, 1] != segments[:, 1, 1]]
     wind = np.zeros((len(xs), len(ys)), dtype=np.int64)
     if len(segments) == 0 or len(xs) == 0:
