@@ -264,21 +264,8 @@ def _digest(*arrays: FloatArray) -> bytes:
 def _within(world: World, room: Room, pts: FloatArray) -> bool:
     """Whether no point of ``pts`` lies in a room other than ``room`` (then the sight lines of
     its coverage meet no furniture but that of ``room``: Scene.line_of_sight)."""
-    boxes = world.room_boxes
-    compiled = kernels()
-    if compiled is not None:  # the same rooms, pair by pair
-        held = compiled.within(pts, boxes[:, 0], boxes[:, 1], 3).any(axis=0)
-        return all(world.room_ids[k] == room.id for k in np.flatnonzero(held).tolist())
-    near = np.flatnonzero(np.all((boxes[:, 0] <= pts.max(axis=0)) &
-                                 (boxes[:, 1] >= pts.min(axis=0)), axis=1))
     ids = world.room_ids
-    others = np.array([ids[k] != room.id for k in near.tolist()], dtype=bool)
-    if not others.any():
-        return True
-    near = near[others]  # the other rooms at once (points x rooms x axes)
-    lo, hi = boxes[near, 0], boxes[near, 1]
-    return not bool(((pts[:, None, :] >= lo[None]) & (pts[:, None, :] <= hi[None]))
-                    .all(axis=2).any())
+    return all(ids[k] == room.id for k in world.rooms_holding(pts).tolist())
 
 
 def in_frame(view: View, eyes: FloatArray, headings: FloatArray, centres: FloatArray,

@@ -202,17 +202,35 @@ class World:
 
     def room_at(self, point: tuple[float, ...] | FloatArray) -> Room | None:
         p = np.asarray(point, dtype=float)
-        boxes = self.room_boxes
+        lo, hi = self.room_bounds
         compiled = kernels()
         if compiled is not None and p.shape == (3,):  # the same rooms, one by one
-            inside = compiled.within(p[None], *self.room_bounds, 3)[0]
+            inside = compiled.within(p[None], lo, hi, 3)[0]
         else:
-            inside = np.all((p >= boxes[:, 0] - 1e-6) & (p <= boxes[:, 1] + 1e-6), axis=1)
+            inside = np.all((p >= lo) & (p <= hi), axis=1)
         for k in np.flatnonzero(inside):  # a room that is no box: in its outline
             room = self.rooms[self.room_ids[k]]
             if not room.outline or inside_polygon(p[None, :2], room.outline)[0]:
                 return room
         return None
+
+    def rooms_holding(self, points: FloatArray) -> np.ndarray:
+        """Indices into :attr:`room_ids`, in order, of the rooms (their boxes, faces included)
+        any of ``points`` lies in."""
+        ends = np.atleast_2d(points)
+        boxes = self.room_boxes
+        compiled = kernels()
+        if compiled is not None and ends.shape[1] == 3 and ends.dtype == float:  # the same
+            return np.flatnonzero(compiled.within(ends, boxes[:, 0], boxes[:, 1], 3)
+                                  .any(axis=0))  # rooms, pair by pair
+        near = np.flatnonzero(np.all((boxes[:, 0] <= ends.max(axis=0)) &
+                                     (boxes[:, 1] >= ends.min(axis=0)), axis=1))
+        if len(near) == 0:
+            return near
+        # the near rooms at once (ends x rooms x axes): the same rooms, one call each
+        lo, hi = boxes[near, 0], boxes[near, 1]
+        held = ((ends[:, None, :] >= lo[None]) & (ends[:, None, :] <= hi[None])).all(axis=2)
+        return near[held.any(axis=0)]
 
     def line_of_sight(self, p0: FloatArray, p1: FloatArray) -> np.ndarray:
         """``(M,)`` mask, true where the segment ``p0[m] -> p1[m]`` meets no solid."""

@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 
-from astralis_des.compiled import kernels
 from astralis_des.kinds import TARGET_HEIGHT
 from astralis_des.memo import kept
 from astralis_des.streams import stream
@@ -302,21 +301,8 @@ class Scene:
 
     def rooms_at(self, points: FloatArray) -> list[str]:
         """The rooms any of ``points`` lies in, in the world's order."""
-        ends = np.atleast_2d(points)
-        boxes = self.world.room_boxes
-        compiled = kernels()
-        if compiled is not None and ends.shape[1] == 3 and ends.dtype == float:  # the same rooms
-            held = compiled.within(ends, boxes[:, 0], boxes[:, 1], 3).any(axis=0)
-            return [self.world.room_ids[k] for k in np.flatnonzero(held).tolist()]
-        near = np.flatnonzero(np.all((boxes[:, 0] <= ends.max(axis=0)) &
-                                     (boxes[:, 1] >= ends.min(axis=0)), axis=1))
-        if len(near) == 0:
-            return []
-        # the near rooms at once (ends x rooms x axes): the same rooms, one call each
-        lo, hi = boxes[near, 0], boxes[near, 1]
-        held = ((ends[:, None, :] >= lo[None]) & (ends[:, None, :] <= hi[None])).all(axis=2)
         ids = self.world.room_ids
-        return [ids[k] for k in near[held.any(axis=0)].tolist()]
+        return [ids[k] for k in self.world.rooms_holding(points).tolist()]
 
 
 def _overlap(a: Box, b: Box) -> bool:
