@@ -185,11 +185,6 @@ class Scene:
     def skipped(self) -> list[tuple[str, str, str]]:
         return [s for rid in sorted(self._rooms) for s in self._rooms[rid].skipped]
 
-    def static_bodies(self, room_ids: Iterable[str]) -> list[Placed]:
-        """Furniture and avatars that stay put (not the patrolling ones) in these rooms."""
-        return [p for rid in room_ids for p in self.clutter(rid).placed
-                if dict(p.attributes).get("activity") != "patrolling"]
-
     def still_boxes(self, room_ids: Iterable[str]) -> FloatArray:
         """``(K, 2, 3)`` corners of what stays put in these rooms: each room's once, kept
         (sight, coverage and planning ask for them again and again)."""
@@ -202,8 +197,7 @@ class Scene:
 
     def patrolling(self, room_id: str) -> list[Placed]:
         """The room's patrolling bystanders, in the order ``avatar_movers`` lists them."""
-        return [p for p in self.clutter(room_id).placed
-                if dict(p.attributes).get("activity") == "patrolling"]
+        return [p for p in self.clutter(room_id).placed if _patrols(p)]
 
     def avatar_movers(self, rooms: Iterable[str] | None = None) -> list[Mover]:
         """Patrolling bystanders of the furnished rooms (or of ``rooms``), as movers, and a
@@ -309,14 +303,18 @@ def _overlap(a: Box, b: Box) -> bool:
     return all(a.lo[k] < b.hi[k] and b.lo[k] < a.hi[k] for k in range(2))
 
 
+def _patrols(placed: Placed) -> bool:
+    """A patrolling bystander (a mover), not furniture or an avatar that stays put."""
+    return dict(placed.attributes).get("activity") == "patrolling"
+
+
 def _still_of(clutter: Clutter) -> FloatArray:
     """The corners of what stays put of ``clutter`` (not the patrolling avatars), kept on it
     read-only: a room's furniture is drawn once per world, seed and room, and each run's
     scene asks for its boxes again."""
     memo = kept(clutter, "still_boxes")
     if "boxes" not in memo:
-        boxes = boxes_array([p.box for p in clutter.placed
-                             if dict(p.attributes).get("activity") != "patrolling"])
+        boxes = boxes_array([p.box for p in clutter.placed if not _patrols(p)])
         boxes.setflags(write=False)
         memo["boxes"] = boxes
     return memo["boxes"]
