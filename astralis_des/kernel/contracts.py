@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     import simpy
 
     from astralis_des.detection import Sighting
-    from astralis_des.kernel.events import EventLog, Record
+    from astralis_des.kernel.events import EventLog
     from astralis_des.kernel.perceived import ImuTrace, KeptCloud, KeptFrame, KeptScan
     from astralis_des.kernel.robot import Motion, Robot
     from astralis_des.mission.loader import Mission
@@ -170,10 +170,3 @@ class PluginSensor(Protocol):
     it reads)."""
 
     def run(self) -> Generator[simpy.Event, Any, None]: ...
-
-
-class Output(Protocol):
-    """A sink of a run's event stream."""
-
-    def on_event(self, record: Record) -> None: ...
-    def close(self, result: Any) -> None: ...

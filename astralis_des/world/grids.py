@@ -63,10 +63,6 @@ def padded(mask: BoolArray, width: int, value: bool) -> BoolArray:
     return out
 
 
-def window_sum(mask: BoolArray, kx: int, ky: int) -> np.ndarray:
-    return window(summed(mask), kx, ky)
-
-
 def erode(walk: BoolArray, radius: float) -> BoolArray:
     """Cells whose disk of ``radius`` cells is all ``walk`` (beyond the grid is not).
 
