@@ -144,12 +144,60 @@ def resample(points: FloatArray, step: float) -> tuple[FloatArray, FloatArray]:
 def inside_polygon(points: FloatArray, polygon: FloatArray | tuple[tuple[float, float], ...]
                    ) -> NDArray[np.bool_]:
     """``(N,)`` mask: is each of ``points`` (``(N, 2)`` or more columns; xy used) inside the
-    closed ``polygon`` (``(M, 2)``)? Even-odd rule, vectorised over points and edges."""
+    closed ``polygon`` (``(M, 2)``)? Even-odd rule, vectorised over points and edges.
+
+    Only the points within the polygon's bounds (widened by :data:`BOUNDS_MARGIN`) are
+    tested: beyond them no edge spans a point's row, or every spanning edge crosses on one
+    side of it, and those come in pairs, so the rule says outside there anyway (a grid of a
+    building's cells against one room's outline, say)."""
     p = np.atleast_2d(np.asarray(points, dtype=float))[:, :2]
     a = np.asarray(polygon, dtype=float)
+    if len(p) > BOUNDED and len(a):
+        lo, hi = a.min(axis=0) - BOUNDS_MARGIN, a.max(axis=0) + BOUNDS_MARGIN
+        near = np.flatnonzero((p[:, 0] >= lo[0]) & (p[:, 0] <= hi[0])
+                              & (p[:, 1] >= lo[1]) & (p[:, 1] <= hi[1]))
+        out = np.zeros(len(p), dtype=bool)
+        if len(near):
+            out[near] = _even_odd(p[near], a)
+        return out
+    return _even_odd(p, a)
+
+
+BOUNDED = 256  # points: from this many, only those within a polygon's bounds are tested
+BOUNDS_MARGIN = 1e-6  # m: far beyond the rounding of an edge's crossing
+ROWS = 4  # points a row (an ordinate) on average, from which the rule is taken row by row
+
+
+def _even_odd(p: FloatArray, a: FloatArray) -> NDArray[np.bool_]:
+    """The even-odd rule: an edge spanning a point's row (ordinate) counts where it crosses
+    that row to the right of the point. Points that share rows (a grid's) are taken a row at
+    a time: each row's crossings are worked out once, in the same arithmetic, and sorted."""
+    if len(p) >= BOUNDED:
+        ys, row = np.unique(p[:, 1], return_inverse=True)
+        if len(ys) * ROWS <= len(p):
+            return _by_rows(p[:, 0], ys, row.ravel(), a)
+    return np.asarray((np.sum(_crossings(p[:, 1:2], a) > p[:, 0:1], axis=1) % 2) == 1)
+
+
+def _crossings(y: FloatArray, a: FloatArray) -> FloatArray:
+    """``(len(y), M)``: where each edge of the closed polygon ``a`` crosses each row ``y``
+    (a column), ``-inf`` for an edge that does not span the row."""
     b = np.roll(a, -1, axis=0)
-    x, y = p[:, 0:1], p[:, 1:2]
-    spans = (a[:, 1] > y) != (b[:, 1] > y)  # (N, M): the edge crosses the point's row
+    spans = (a[:, 1] > y) != (b[:, 1] > y)
     dy = np.where(b[:, 1] == a[:, 1], 1.0, b[:, 1] - a[:, 1])
     cross_x = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / dy
-    return np.asarray((np.sum(spans & (x < cross_x), axis=1) % 2) == 1)
+    return np.where(spans, cross_x, -np.inf)
+
+
+def _by_rows(x: FloatArray, ys: FloatArray, row: NDArray[np.intp], a: FloatArray
+             ) -> NDArray[np.bool_]:
+    """The rule for points at abscissae ``x`` on rows ``ys[row]``: in each row, the count of
+    crossings right of a point is the row's crossings less those at or left of it."""
+    crossings = np.sort(_crossings(ys[:, None], a), axis=1)
+    order = np.argsort(row, kind="stable")
+    starts = np.searchsorted(row[order], np.arange(len(ys) + 1))
+    right = np.empty(len(x), dtype=np.intp)
+    for r in range(len(ys)):
+        mine = order[starts[r]:starts[r + 1]]
+        right[mine] = a.shape[0] - np.searchsorted(crossings[r], x[mine], side="right")
+    return np.asarray(right % 2 == 1)
