@@ -125,47 +125,77 @@ def cast_boxes(centre: FloatArray, dirs: FloatArray, heading: float, elevations:
     index (``inf``, -1: none). A beam starting inside a box misses it, unless ``inside``
     (then it enters at ``start``). Each box is tested only along the beams of the window of
     azimuths and elevations its corners span from ``centre`` (all azimuths from inside its
-    footprint); ties go to the lower index."""
+    footprint), every box's beams at once; ties go to the lower index."""
     n_ch, n_az = dirs.shape[:2]
-    best = np.full((n_ch, n_az), np.inf)
-    which = np.full((n_ch, n_az), -1, dtype=np.intp)
+    best = np.full(n_ch * n_az, np.inf)
+    which = np.full(n_ch * n_az, -1, dtype=np.intp)
     if not len(lo):
-        return best, which
+        return best.reshape(n_ch, n_az), which.reshape(n_ch, n_az)
     rel_lo, rel_hi = lo - centre, hi - centre
     gap = np.maximum(np.maximum(rel_lo, -rel_hi), 0.0)
     near = np.flatnonzero(np.einsum("ij,ij->i", gap, gap) <= stop * stop)
-    inv = 1.0 / np.where(np.abs(dirs) < TINY, np.copysign(TINY, dirs), dirs)
-    for k in near.tolist():
-        a0, a1, b0, b1 = rel_lo[k, 0], rel_hi[k, 0], rel_lo[k, 1], rel_hi[k, 1]
-        r_min = math.hypot(gap[k, 0], gap[k, 1])
-        r_max = max(math.hypot(x, y) for x in (a0, a1) for y in (b0, b1))
-        z0, z1 = rel_lo[k, 2], rel_hi[k, 2]
-        # the lowest elevation: the bottom, nearest if below the sensor, else farthest
-        e_lo = math.atan2(z0, max(r_min, 1e-12) if z0 < 0 else r_max) - SLACK
-        e_hi = math.atan2(z1, max(r_min, 1e-12) if z1 > 0 else r_max) + SLACK
-        channels = np.flatnonzero((elevations >= e_lo) & (elevations <= e_hi))
-        if not len(channels):
-            continue
-        if r_min == 0.0:  # over or under its footprint: every azimuth
-            cols = np.arange(n_az)
-        else:
-            mid = math.atan2(0.5 * (b0 + b1), 0.5 * (a0 + a1))
-            offs = [math.remainder(math.atan2(y, x) - mid, math.tau)
-                    for x in (a0, a1) for y in (b0, b1)]
-            first = math.floor((mid + min(offs) - SLACK - heading) / step)
-            last = math.ceil((mid + max(offs) + SLACK - heading) / step)
-            cols = np.arange(first, last + 1) % n_az
-        d = inv[channels[:, None], cols[None, :]]  # (c, a, 3) inverse directions
-        t1, t2 = rel_lo[k] * d, rel_hi[k] * d
-        enter = np.minimum(t1, t2).max(axis=-1)
-        leave = np.maximum(t1, t2).min(axis=-1)
-        if inside:
-            enter = np.maximum(enter, start)
-        ok = (enter <= leave) & (enter >= start) & (enter <= stop)
-        sub = best[channels[:, None], cols[None, :]]
-        better = ok & (enter < sub)
-        if better.any():
-            ci, ai = np.nonzero(better)
-            best[channels[ci], cols[ai]] = enter[ci, ai]
-            which[channels[ci], cols[ai]] = k
-    return best, which
+    box, channel, first, count = _windows(rel_lo[near], rel_hi[near], gap[near], heading,
+                                          elevations, step, n_az)
+    if not len(box):
+        return best.reshape(n_ch, n_az), which.reshape(n_ch, n_az)
+    pair = np.repeat(np.arange(len(box)), count)  # each beam of each window: its pair's
+    local = np.arange(len(pair)) - np.repeat(np.cumsum(count) - count, count)
+    beam = channel[pair] * n_az + (first[pair] + local) % n_az
+    inv = inverse(dirs.reshape(-1, 3).T)  # per axis
+    boxes = near[box[pair]]
+    enter = np.full(len(beam), -np.inf)
+    leave = np.full(len(beam), np.inf)
+    for axis in range(3):  # the slab test, an axis at a time
+        d = inv[axis][beam]
+        t1, t2 = rel_lo[boxes, axis] * d, rel_hi[boxes, axis] * d
+        np.maximum(enter, np.minimum(t1, t2), out=enter)
+        np.minimum(leave, np.maximum(t1, t2), out=leave)
+    if inside:
+        enter = np.maximum(enter, start)
+    ok = np.flatnonzero((enter <= leave) & (enter >= start) & (enter <= stop))
+    np.minimum.at(best, beam[ok], enter[ok])
+    won = ok[enter[ok] == best[beam[ok]]]  # the nearest entries; ties: the lowest index
+    first_box = np.full(n_ch * n_az, len(lo), dtype=np.intp)
+    np.minimum.at(first_box, beam[won], boxes[won])
+    which[beam[won]] = first_box[beam[won]]
+    return best.reshape(n_ch, n_az), which.reshape(n_ch, n_az)
+
+
+def inverse(dirs: FloatArray) -> FloatArray:
+    """``1 / dirs``, a component under ``TINY`` taken as ``TINY`` of its sign."""
+    with np.errstate(divide="ignore"):
+        inv = 1.0 / dirs
+    tiny = np.abs(dirs) < TINY
+    if tiny.any():
+        inv[tiny] = 1.0 / np.copysign(TINY, dirs[tiny])
+    return inv
+
+
+def _windows(rel_lo: FloatArray, rel_hi: FloatArray, gap: FloatArray, heading: float,
+             elevations: FloatArray, step: float, n_az: int
+             ) -> tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.intp], NDArray[np.intp]]:
+    """The beams each box may meet, as ``(box, channel)`` pairs (by box, then channel) and
+    each pair's azimuths: ``count`` of them from ``first`` on (modulo a turn). A box spans
+    the elevations from its bottom (nearest if below the sensor, else farthest) to its top,
+    and the azimuths its corners span (all from inside its footprint); both windows are
+    widened by ``SLACK``, beyond any rounding of the angles, so no beam that meets the box is
+    left out (and a beam let in that does not is missed by the slab test)."""
+    a0, a1, b0, b1 = rel_lo[:, 0], rel_hi[:, 0], rel_lo[:, 1], rel_hi[:, 1]
+    r_min = np.hypot(gap[:, 0], gap[:, 1])
+    corners_x = np.stack([a0, a0, a1, a1], axis=1)
+    corners_y = np.stack([b0, b1, b0, b1], axis=1)
+    r_max = np.hypot(corners_x, corners_y).max(axis=1)
+    z0, z1 = rel_lo[:, 2], rel_hi[:, 2]
+    near_r = np.maximum(r_min, 1e-12)
+    e_lo = np.arctan2(z0, np.where(z0 < 0, near_r, r_max)) - SLACK
+    e_hi = np.arctan2(z1, np.where(z1 > 0, near_r, r_max)) + SLACK
+    box, channel = np.nonzero((elevations >= e_lo[:, None]) & (elevations <= e_hi[:, None]))
+    mid = np.arctan2(0.5 * (b0 + b1), 0.5 * (a0 + a1))
+    offs = np.arctan2(corners_y, corners_x) - mid[:, None]
+    offs -= math.tau * np.round(offs / math.tau)  # within half a turn of the middle
+    first = np.floor((mid + offs.min(axis=1) - SLACK - heading) / step).astype(np.intp)
+    last = np.ceil((mid + offs.max(axis=1) + SLACK - heading) / step).astype(np.intp)
+    around = r_min == 0.0  # over or under its footprint: every azimuth
+    first = np.where(around, 0, first)
+    count = np.where(around, n_az, last - first + 1)
+    return box, channel, first[box], count[box]
