@@ -10,6 +10,7 @@ import math
 import numpy as np
 import pytest
 
+from astralis_des.physics import lidar3d
 from astralis_des.physics.lidar3d import SLACK, Lidar3D, cast_boxes
 from astralis_des.physics.planar import TINY
 
@@ -75,7 +76,11 @@ def scene(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
 
 @pytest.mark.parametrize("seed", range(4))
 @pytest.mark.parametrize("inside", [False, True])
-def test_every_box_at_once_answers_as_box_by_box(seed: int, inside: bool) -> None:
+@pytest.mark.parametrize("pairs", [lidar3d.PAIRS, 500])
+def test_every_box_at_once_answers_as_box_by_box(seed: int, inside: bool, pairs: int,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    """Also a few hundred beam-box pairs at a time (a box's windows split between them)."""
+    monkeypatch.setattr(lidar3d, "PAIRS", pairs)
     rng = np.random.default_rng(seed)
     lidar = Lidar3D.__new__(Lidar3D)  # its beams alone: no client needed
     lidar.elevations = np.radians(np.linspace(-15.0, 15.0, 16))

@@ -125,24 +125,55 @@ def cast_boxes(centre: FloatArray, dirs: FloatArray, heading: float, elevations:
     index (``inf``, -1: none). A beam starting inside a box misses it, unless ``inside``
     (then it enters at ``start``). Each box is tested only along the beams of the window of
     azimuths and elevations its corners span from ``centre`` (all azimuths from inside its
-    footprint), every box's beams at once; ties go to the lower index."""
+    footprint), the boxes' windows together, :data:`PAIRS` beams at a time; ties go to the
+    lower index."""
     n_ch, n_az = dirs.shape[:2]
     best = np.full(n_ch * n_az, np.inf)
     which = np.full(n_ch * n_az, -1, dtype=np.intp)
-    if not len(lo):
-        return best.reshape(n_ch, n_az), which.reshape(n_ch, n_az)
-    rel_lo, rel_hi = lo - centre, hi - centre
-    gap = np.maximum(np.maximum(rel_lo, -rel_hi), 0.0)
-    near = np.flatnonzero(np.einsum("ij,ij->i", gap, gap) <= stop * stop)
-    box, channel, first, count = _windows(rel_lo[near], rel_hi[near], gap[near], heading,
-                                          elevations, step, n_az)
-    if not len(box):
-        return best.reshape(n_ch, n_az), which.reshape(n_ch, n_az)
-    pair = np.repeat(np.arange(len(box)), count)  # each beam of each window: its pair's
-    local = np.arange(len(pair)) - np.repeat(np.cumsum(count) - count, count)
-    beam = channel[pair] * n_az + (first[pair] + local) % n_az
-    inv = inverse(dirs.reshape(-1, 3).T)  # per axis
-    boxes = near[box[pair]]
+    if len(lo):
+        rel_lo, rel_hi = lo - centre, hi - centre
+        gap = np.maximum(np.maximum(rel_lo, -rel_hi), 0.0)
+        near = np.flatnonzero(np.einsum("ij,ij->i", gap, gap) <= stop * stop)
+        box, channel, first, count = _windows(rel_lo[near], rel_hi[near], gap[near], heading,
+                                              elevations, step, n_az)
+        inv = inverse(dirs.reshape(-1, 3).T)  # per axis
+        ends = np.cumsum(count)
+        cuts = np.searchsorted(ends, np.arange(PAIRS, ends[-1] if len(ends) else 0, PAIRS),
+                               side="right")
+        for a, b in zip([0, *cuts.tolist()], [*cuts.tolist(), len(box)], strict=True):
+            if b > a:  # the (box, channel) pairs a to b, by box then channel
+                window = _Window(near[box[a:b]], channel[a:b], first[a:b], count[a:b])
+                _nearest(best, which, window, inv, rel_lo, rel_hi, n_az,
+                         (start, stop, inside))
+    return best.reshape(n_ch, n_az), which.reshape(n_ch, n_az)
+
+
+PAIRS = 1 << 18  # beam-box pairs tested at once (a few MB of arrays), the rest after them
+
+
+@dataclass
+class _Window:
+    """Boxes' windows of beams: for each ``(box, channel)`` pair, ``count`` azimuths from
+    ``first`` on (modulo a turn)."""
+
+    box: NDArray[np.intp]
+    channel: NDArray[np.intp]
+    first: NDArray[np.intp]
+    count: NDArray[np.intp]
+
+
+def _nearest(best: FloatArray, which: NDArray[np.intp], window: _Window, inv: FloatArray,
+             rel_lo: FloatArray, rel_hi: FloatArray, n_az: int,
+             span: tuple[float, float, bool]) -> None:
+    """Each beam's nearest entry into a box of ``window`` and that box (the lowest of equals)
+    into ``best`` and ``which`` (flat, a beam a row), where nearer than what they hold: the
+    windows come in boxes' order, so an equal entry keeps the lower box."""
+    start, stop, inside = span
+    pair = np.repeat(np.arange(len(window.box)), window.count)
+    local = np.arange(len(pair)) - np.repeat(np.cumsum(window.count) - window.count,
+                                             window.count)
+    beam = window.channel[pair] * n_az + (window.first[pair] + local) % n_az
+    boxes = window.box[pair]
     enter = np.full(len(beam), -np.inf)
     leave = np.full(len(beam), np.inf)
     for axis in range(3):  # the slab test, an axis at a time
@@ -153,12 +184,14 @@ def cast_boxes(centre: FloatArray, dirs: FloatArray, heading: float, elevations:
     if inside:
         enter = np.maximum(enter, start)
     ok = np.flatnonzero((enter <= leave) & (enter >= start) & (enter <= stop))
-    np.minimum.at(best, beam[ok], enter[ok])
-    won = ok[enter[ok] == best[beam[ok]]]  # the nearest entries; ties: the lowest index
-    first_box = np.full(n_ch * n_az, len(lo), dtype=np.intp)
-    np.minimum.at(first_box, beam[won], boxes[won])
-    which[beam[won]] = first_box[beam[won]]
-    return best.reshape(n_ch, n_az), which.reshape(n_ch, n_az)
+    nearest = np.full(len(best), np.inf)
+    np.minimum.at(nearest, beam[ok], enter[ok])
+    won = ok[enter[ok] == nearest[beam[ok]]]  # the nearest entries; ties: the lowest index
+    lowest = np.full(len(best), np.iinfo(np.intp).max, dtype=np.intp)
+    np.minimum.at(lowest, beam[won], boxes[won])
+    nearer = np.flatnonzero(nearest < best)
+    best[nearer] = nearest[nearer]
+    which[nearer] = lowest[nearer]
 
 
 def inverse(dirs: FloatArray) -> FloatArray:
