@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from astralis_des.physics.client import PhysicsClient
-from astralis_des.physics.planar import TINY
+from astralis_des.physics.planar import TINY, inverse
 from astralis_des.physics.sensors import NO_BODY, _body_pose, _need_rng
 from astralis_des.world.geometry import FloatArray
 
@@ -192,16 +192,6 @@ def _nearest(best: FloatArray, which: NDArray[np.intp], window: _Window, inv: Fl
     nearer = np.flatnonzero(nearest < best)
     best[nearer] = nearest[nearer]
     which[nearer] = lowest[nearer]
-
-
-def inverse(dirs: FloatArray) -> FloatArray:
-    """``1 / dirs``, a component under ``TINY`` taken as ``TINY`` of its sign."""
-    with np.errstate(divide="ignore"):
-        inv = 1.0 / dirs
-    tiny = np.abs(dirs) < TINY
-    if tiny.any():
-        inv[tiny] = 1.0 / np.copysign(TINY, dirs[tiny])
-    return inv
 
 
 def _windows(rel_lo: FloatArray, rel_hi: FloatArray, gap: FloatArray, heading: float,

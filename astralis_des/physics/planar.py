@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from astralis_des.world.geometry import FloatArray
 
-__all__ = ["BoxIndex", "crossings", "cut"]
+__all__ = ["BoxIndex", "crossings", "cut", "inverse"]
 
 TINY = 1e-12  # a direction component smaller than this is taken as this (no 0 / 0)
 
@@ -28,9 +28,7 @@ def crossings(lo: FloatArray, hi: FloatArray, centre: FloatArray, directions: Fl
     where it misses. A ray starting inside a box misses it, as in Bullet, unless ``inside``:
     then it enters at ``start``."""
     x, y = float(centre[0]), float(centre[1])
-    dx, dy = directions[:, 0], directions[:, 1]
-    inv_x = 1.0 / np.where(np.abs(dx) < TINY, np.copysign(TINY, dx), dx)
-    inv_y = 1.0 / np.where(np.abs(dy) < TINY, np.copysign(TINY, dy), dy)
+    inv_x, inv_y = inverse(directions[:, :2].T)
     # where each ray crosses each box's x and y faces; inside both slabs is inside the box
     t_x0 = (lo[:, 0] - x)[:, None] * inv_x
     t_x1 = (hi[:, 0] - x)[:, None] * inv_x
@@ -45,6 +43,16 @@ def crossings(lo: FloatArray, hi: FloatArray, centre: FloatArray, directions: Fl
         np.maximum(enter, start, out=enter)
     enter[(enter < start) | (enter > leave) | (enter > stop)] = np.inf
     return enter
+
+
+def inverse(dirs: FloatArray) -> FloatArray:
+    """``1 / dirs``, a component under ``TINY`` taken as ``TINY`` of its sign."""
+    with np.errstate(divide="ignore"):
+        inv = 1.0 / dirs
+    tiny = np.abs(dirs) < TINY
+    if tiny.any():
+        inv[tiny] = 1.0 / np.copysign(TINY, dirs[tiny])
+    return inv
 
 
 def cut(lo: FloatArray, hi: FloatArray, centre: FloatArray, reach: float) -> NDArray[np.intp]:
