@@ -106,6 +106,11 @@ def main() -> None:
     print(f"  inside stepSimulation {stepping:.2f} s: overhead ratio "
           f"{(wall - sensing) / stepping:.2f} leaving the sensors out (goal <= 1.4), "
           f"{wall / stepping:.2f} with them")
+    floor = stepping + sensing
+    print(f"  the run's floor, Bullet's steps and the sensors alone: {floor:.2f} s, at most "
+          f"{result.end_time / floor:.1f}x if nothing else cost a thing; 40x leaves "
+          f"{result.end_time / 40 - floor:.2f} s for everything else, against "
+          f"{wall - floor:.2f} s now")
     for name, seconds in result.sensor_time.items():
         calls = result.sensor_calls[name]
         print(f"  sensor {name:<12} {seconds * 1e3:6.0f} ms, {seconds / wall:5.1%} of the run, "
@@ -127,10 +132,14 @@ def main() -> None:
           f"({(idle - bare) / bare:+.1%}; goal < +5%)")
     with tempfile.TemporaryDirectory() as cache:
         cached = whole_process(args.mission, args.repeat, user_env(cache), warm=True)
+        imports = imports_only(args.repeat, user_env(cache))
     print(f"astralis run {Path(args.mission).name} --fidelity physics, the whole process with "
           f"the recording (bytecode cached, as Python does by default): median {cached:.2f} s "
           f"of {args.repeat}, {result.end_time / cached:.1f}x real time (goal >= 25x; "
           f"{result.end_time / cached / raw_rate:.0%} of raw PyBullet's)")
+    print(f"  its floor: a process that only imports what it imports ({imports:.2f} s) and the "
+          f"run's floor above: {imports + floor:.2f} s, at most "
+          f"{result.end_time / (imports + floor):.1f}x")
     if os.environ.get("PYTHONDONTWRITEBYTECODE"):
         env = {**os.environ, "PYTHONPATH": str(ROOT)}
         compiled = whole_process(args.mission, args.repeat, env, warm=False)
@@ -158,6 +167,23 @@ def whole_process(mission: str, repeat: int, env: dict[str, str], warm: bool) ->
                            capture_output=True, check=True, env=env)
             if k >= warm:
                 times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+IMPORTS = ("import astralis_des.cli, astralis_des.simulation, astralis_des.cosim.physics, "
+           "astralis_des.sinks.files, astralis_des.sinks.recording, pybullet, rerun")
+
+
+def imports_only(repeat: int, env: dict[str, str]) -> float:
+    """Median wall seconds of a Python process that only imports what ``astralis run
+    --fidelity physics`` imports (the bytecode written first, as by ``whole_process``)."""
+    times = []
+    for k in range(repeat + 1):
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-c", IMPORTS], capture_output=True, check=True,
+                       env=env)
+        if k:
+            times.append(time.perf_counter() - t0)
     return statistics.median(times)
 
 
