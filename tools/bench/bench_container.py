@@ -36,8 +36,7 @@ def astralis() -> list[str]:
     exe = Path(sys.executable).with_name("astralis")
     if exe.is_file():
         return [str(exe)]
-    return [sys.executable, "-c", "import sys; from astralis_des.cli import main; "
-            "sys.exit(main())"]
+    return [sys.executable, "-c", "from astralis_des.cli import entry; entry()"]
 
 
 def timed(cmd: list[str], cwd: Path) -> float:

@@ -42,7 +42,7 @@ sys.path.insert(0, str(ROOT))
 AUTZEN = ROOT / "data" / "real" / "autzen_trim.laz"
 CORPUS = ROOT / "data" / "scans"
 SUFFIXES = (".las", ".laz", ".pcd", ".ply", ".xyz", ".csv", ".obj", ".stl", ".glb", ".gltf")
-CLI = "import sys; from astralis_des.cli import main; sys.exit(main())"
+CLI = "from astralis_des.cli import entry; entry()"  # the `astralis` program
 READ_ONLY = """
 import sys, time, laspy, numpy as np
 t0 = time.perf_counter()

@@ -10,6 +10,9 @@ A process keeps what it furnished and the coverage it judged (per room, seed and
 the default mission run again in the same process is faster than its first run: both are
 printed, the first run measured in a fresh process. The 1,000 missions (seeds 0..999, each
 furnished anew) run in fresh worker processes, which inherit nothing from this one.
+
+Beside the outputs' share, their floors: Rerun alone writing the run's recording from its
+chunks ready-made, and the event log and summary staged, synced and put in place.
 """
 
 from __future__ import annotations

@@ -9,12 +9,14 @@ Measured in one run, on this machine:
   (cameras looking 4 times a second while searching, the UGV's lidar at 10 Hz and the IMUs at
   20 Hz while moving): wall time, time inside ``stepSimulation``, their ratio (the overhead
   ratio), the real-time factor, and each sensor's share (``camera`` renders frames,
-  ``camera_cull`` tests whether the target can be in view at all);
+  ``camera_cull`` tests whether the target can be in view at all); the run's floor, Bullet's
+  steps and the sensors alone, and what the 40x goal leaves everything else;
 - the recording's share (the same run without outputs);
 - the same mission after a one-hour idle wait (``assignment.start_at: 3600``);
 - ``astralis run missions/urban_search.yaml --fidelity physics`` as a user runs it: the whole
   process, start-up, recording and summary included, with the package's bytecode cached (as
-  Python does by default) and, where PYTHONDONTWRITEBYTECODE is set, compiled each time;
+  Python does by default) and, where PYTHONDONTWRITEBYTECODE is set, compiled each time; and
+  its floor, a process that only imports what it imports, plus the run's floor;
 - a team-size curve (``--teams 4 8 16 32 64 100``): the default mission with half the team
   UAVs and half UGVs, in physics with the default sensors and no outputs, idle UGVs asleep
   in Bullet (``physics.sleep_idle``, the default; ``--awake`` keeps them awake): real-time
@@ -171,12 +173,14 @@ def whole_process(mission: str, repeat: int, env: dict[str, str], warm: bool) ->
 
 
 IMPORTS = ("import astralis_des.cli, astralis_des.simulation, astralis_des.cosim.physics, "
-           "astralis_des.sinks.files, astralis_des.sinks.recording, pybullet, rerun")
+           "astralis_des.sinks.files, astralis_des.sinks.recording, pybullet, rerun; "
+           "astralis_des.cli.end_process(0)")  # and ends as `astralis` does
 
 
 def imports_only(repeat: int, env: dict[str, str]) -> float:
     """Median wall seconds of a Python process that only imports what ``astralis run
-    --fidelity physics`` imports (the bytecode written first, as by ``whole_process``)."""
+    --fidelity physics`` imports and ends as it does (the bytecode written first, as by
+    ``whole_process``)."""
     times = []
     for k in range(repeat + 1):
         t0 = time.perf_counter()
