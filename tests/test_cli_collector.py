@@ -67,3 +67,17 @@ def test_a_caller_without_a_collector_is_left_without_one(tmp_path: Path) -> Non
         assert gc.get_freeze_count() == 0
     finally:
         gc.enable()
+
+
+def test_a_callers_own_frozen_objects_stay_frozen(tmp_path: Path) -> None:
+    """A server that froze its objects before forking calls ``main``: they stay frozen."""
+    gc.freeze()
+    try:
+        frozen = gc.get_freeze_count()
+        code, _, stderr = run_cli("run", str(MISSION), "--out", str(tmp_path / "out"),
+                                  "--quiet", "--no-recording")
+        assert code == 0, stderr
+        assert gc.isenabled()
+        assert 0 < gc.get_freeze_count() <= frozen  # not unfrozen (some died meanwhile)
+    finally:
+        gc.unfreeze()
