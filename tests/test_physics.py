@@ -3,8 +3,11 @@ kinematic fidelity, determinism, simulations side by side, idle time, failures."
 
 from __future__ import annotations
 
+import gc
 import itertools
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -146,3 +149,21 @@ def test_a_nan_state_fails_the_motion(monkeypatch: pytest.MonkeyPatch) -> None:
     start = sim.robots["uav1"].pose
     outcome = run_motion(sim, "uav1", [tuple(start), (86.0, 70.0, 1.5)], 5.0)
     assert outcome is not None and "NaN" in outcome.reason  # type: ignore[attr-defined]
+
+
+def test_a_simulation_never_finished_leaves_no_folder_behind() -> None:
+    """The UAV model is written to a temporary folder per physics simulation: removed when
+    the run ends, and also when a simulation that never ran or never ended is let go (or the
+    process exits): a notebook's abandoned runs leave nothing in /tmp."""
+    sim = Simulation(physics("fig7"))
+    folder = sim.cosim._folder
+    assert (folder / "hexacopter.urdf").is_file()
+    del sim
+    gc.collect()
+    assert not folder.exists()
+    probe = ("import sys; from pathlib import Path; from astralis_des import Simulation, "
+             "load_mission; sim = Simulation(load_mission(Path(sys.argv[1])).with_changes("
+             "fidelity='physics')); print(sim.cosim._folder)")
+    done = subprocess.run([sys.executable, "-c", probe, str(MISSIONS / "fig7.yaml")],
+                          capture_output=True, text=True, timeout=120, check=True)
+    assert not Path(done.stdout.strip()).exists()  # at the process's exit

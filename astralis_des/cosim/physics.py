@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import shutil
 import tempfile
+import weakref
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -55,6 +56,8 @@ class PhysicsCoSim:
         self.client = PhysicsClient(sim.world, spec.dt, spec.rate // spec.control_rate,
                                     spec.solver_iterations)
         self._folder = Path(tempfile.mkdtemp(prefix="astralis-"))
+        # removed at close, or when a simulation never ended is let go, or at the exit
+        self._remove_folder = weakref.finalize(self, shutil.rmtree, self._folder, True)
         urdf = write_urdf(spec.uav, self._folder)
         self.drivers: dict[str, Driver] = {
             rid: DRIVERS.get(robot.kind)(self.client, robot, spec, urdf)
@@ -231,7 +234,7 @@ class PhysicsCoSim:
 
     def close(self) -> None:
         self.client.close()
-        shutil.rmtree(self._folder, ignore_errors=True)
+        self._remove_folder()
 
     @property
     def step_time(self) -> float:
