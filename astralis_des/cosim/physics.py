@@ -57,7 +57,8 @@ class PhysicsCoSim:
                                     spec.solver_iterations)
         self._folder = Path(tempfile.mkdtemp(prefix="astralis-"))
         # removed at close, or when a simulation never ended is let go, or at the exit
-        self._remove_folder = weakref.finalize(self, shutil.rmtree, self._folder, True)
+        self._remove_folder = weakref.finalize(self, shutil.rmtree, self._folder,
+                                               ignore_errors=True)
         urdf = write_urdf(spec.uav, self._folder)
         self.drivers: dict[str, Driver] = {
             rid: DRIVERS.get(robot.kind)(self.client, robot, spec, urdf)

@@ -161,15 +161,9 @@ def user_env(cache: str) -> dict[str, str]:
 def whole_process(mission: str, repeat: int, env: dict[str, str], warm: bool) -> float:
     """Median wall seconds of ``astralis run MISSION --fidelity physics`` with the recording,
     after one run that writes the bytecode when ``warm``."""
-    times = []
     with tempfile.TemporaryDirectory() as tmp:
-        for k in range(repeat + warm):
-            t0 = time.perf_counter()
-            subprocess.run(["astralis", "run", mission, "--fidelity", "physics", "--out", tmp],
-                           capture_output=True, check=True, env=env)
-            if k >= warm:
-                times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+        return processes(["astralis", "run", mission, "--fidelity", "physics", "--out", tmp],
+                         repeat, env, warm)
 
 
 IMPORTS = ("import astralis_des.cli, astralis_des.simulation, astralis_des.cosim.physics, "
@@ -181,12 +175,17 @@ def imports_only(repeat: int, env: dict[str, str]) -> float:
     """Median wall seconds of a Python process that only imports what ``astralis run
     --fidelity physics`` imports and ends as it does (the bytecode written first, as by
     ``whole_process``)."""
+    return processes([sys.executable, "-c", IMPORTS], repeat, env, warm=True)
+
+
+def processes(cmd: list[str], repeat: int, env: dict[str, str], warm: bool) -> float:
+    """Median wall seconds of ``repeat`` runs of ``cmd``, after one that writes the bytecode
+    when ``warm``."""
     times = []
-    for k in range(repeat + 1):
+    for k in range(repeat + warm):
         t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-c", IMPORTS], capture_output=True, check=True,
-                       env=env)
-        if k:
+        subprocess.run(cmd, capture_output=True, check=True, env=env)
+        if k >= warm:
             times.append(time.perf_counter() - t0)
     return statistics.median(times)
 
